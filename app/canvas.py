@@ -1,0 +1,525 @@
+"""The canvas: the derived drawing rendered by ``lsys_core.render`` into a zero-copy QImage.
+
+Rendering runs on a worker (:class:`~app.workers.LatestRunner`): a request snapshots the
+drawing, the view (zoom, offset, device pixel ratio, size) and the quality; the worker draws
+with skia into one of two :class:`~lsys_core.render.Renderer` surfaces (double buffering: the
+one on screen is never drawn into) and wraps the pixels as a QImage without copying; the UI
+thread only calls ``QPainter.drawImage``.  While the user drags a slider, pans or zooms, drafts
+are rendered (and the last frame is shown transformed to the new view until the next one
+arrives); full anti-aliased quality follows as soon as the interaction stops.
+
+Also: pan (drag, space-drag, middle button), zoom at the cursor (wheel), fit / 100 %, an
+optional overlay of the input SVG, colouring by similarity group or by rule, and picking the
+element under a click.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from PySide6.QtCore import QPointF, QRectF, QSize, Qt, QTimer, Signal
+from PySide6.QtGui import QColor, QImage, QPainter, QPen, QTransform
+from PySide6.QtWidgets import QSizePolicy, QWidget
+
+from . import core
+from .workers import LatestRunner
+
+__all__ = ["Canvas", "Frame", "RenderRequest", "View", "recolor"]
+
+SETTLE_MS = 120  # quiet time after pan/zoom before rendering at full quality
+MIN_ZOOM, MAX_ZOOM = 1e-4, 1e4
+#: Colours cycled for the colour-by-group / colour-by-rule modes.
+PALETTE = (
+    "#1f77b4",
+    "#ff7f0e",
+    "#2ca02c",
+    "#d62728",
+    "#9467bd",
+    "#8c564b",
+    "#e377c2",
+    "#7f7f7f",
+    "#bcbd22",
+    "#17becf",
+    "#393b79",
+    "#e7ba52",
+    "#637939",
+    "#ad494a",
+    "#7b4173",
+    "#3182bd",
+)
+
+
+@dataclass(frozen=True)
+class View:
+    """How document coordinates map to the widget: ``widget = doc * zoom + (ox, oy)`` (logical pixels)."""
+
+    zoom: float = 1.0
+    ox: float = 0.0
+    oy: float = 0.0
+
+    def to_widget(self, x: float, y: float) -> tuple[float, float]:
+        """Map a document point to widget (logical pixel) coordinates."""
+        return x * self.zoom + self.ox, y * self.zoom + self.oy
+
+    def to_doc(self, x: float, y: float) -> tuple[float, float]:
+        """Map a widget point to document coordinates."""
+        return (x - self.ox) / self.zoom, (y - self.oy) / self.zoom
+
+    def transform(self) -> QTransform:
+        """Return the document → widget transform."""
+        return QTransform(self.zoom, 0, 0, self.zoom, self.ox, self.oy)
+
+
+@dataclass(frozen=True)
+class RenderRequest:
+    """One frame to render: immutable inputs only (plus the surface to draw into)."""
+
+    drawing: Any
+    view: View
+    width: int
+    height: int
+    dpr: float
+    draft: bool
+    renderer: Any
+    slot: int
+    overlay: Any = None  # a QSvgRenderer of the input, painted translucently on top
+    overlay_rect: QRectF | None = None
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A rendered frame: the QImage, the array it wraps (kept alive with it), and its inputs."""
+
+    image: QImage
+    pixels: np.ndarray
+    renderer: Any
+    slot: int
+    drawing: Any
+    view: View
+    size: tuple[int, int]
+    dpr: float
+    draft: bool
+    overlay: bool
+    seconds: float
+
+
+def render_frame(req: RenderRequest, cancel, progress) -> Frame:
+    """Render ``req`` on a worker: skia draws into the request's surface, wrapped zero-copy."""
+    t0 = time.perf_counter()
+    s = req.dpr
+    view = (req.view.zoom * s, 0.0, req.view.ox * s, 0.0, req.view.zoom * s, req.view.oy * s)
+    pixels = req.renderer.draw(req.drawing, view, antialias=not req.draft, draft=req.draft)
+    cancel.check()
+    h, w = pixels.shape[:2]
+    image = QImage(pixels.data, w, h, pixels.strides[0], core.RENDER_FORMAT)
+    image.setDevicePixelRatio(s)
+    if req.overlay is not None and req.overlay_rect is not None:
+        painter = QPainter(image)
+        painter.setRenderHint(QPainter.RenderHint.Antialiasing, not req.draft)
+        painter.setTransform(req.view.transform())
+        painter.setOpacity(0.35)
+        req.overlay.render(painter, req.overlay_rect)
+        painter.end()
+    return Frame(
+        image,
+        pixels,
+        req.renderer,
+        req.slot,
+        req.drawing,
+        req.view,
+        (req.width, req.height),
+        s,
+        req.draft,
+        req.overlay is not None,
+        time.perf_counter() - t0,
+    )
+
+
+def _style_with_color(style: str, color: str) -> str:
+    """Return CSS declarations with fill and stroke (where painted) set to ``color``."""
+    decls = {}
+    for part in style.split(";"):
+        if ":" in part:
+            k, v = part.split(":", 1)
+            decls[k.strip()] = v.strip()
+    if decls.get("fill", "black") != "none":
+        decls["fill"] = color
+    if decls.get("stroke", "none") != "none":
+        decls["stroke"] = color
+    return ";".join(f"{k}:{v}" for k, v in decls.items())
+
+
+def recolor(drawing: Any, mode: str) -> Any:
+    """Return ``drawing`` with terminal styles coloured by similarity group or by rule.
+
+    ``mode`` is ``"none"`` (unchanged), ``"group"`` (one colour per terminal symbol, i.e. per
+    similarity group) or ``"rule"`` (one colour per rule that emitted the instance; terminals
+    drawn by several rules are split into one styled copy per rule).
+    """
+    if mode == "none" or drawing is None or len(drawing) == 0:
+        return drawing
+    terms = drawing.terminals
+    if mode == "group":
+        styled = tuple(
+            dataclasses.replace(t, style=_style_with_color(t.style, PALETTE[i % len(PALETTE)]))
+            for i, t in enumerate(terms)
+        )
+        return dataclasses.replace(drawing, terminals=styled)
+    pairs, inverse = np.unique(np.stack([drawing.symbol, drawing.rule], axis=1), axis=0, return_inverse=True)
+    styled = tuple(
+        dataclasses.replace(
+            terms[s], style=_style_with_color(terms[s].style, PALETTE[(r + 1) % len(PALETTE)])
+        )
+        for s, r in pairs.tolist()
+    )
+    return dataclasses.replace(drawing, terminals=styled, symbol=inverse.reshape(-1).astype(np.int32))
+
+
+class Canvas(QWidget):
+    """The central view of the derived drawing.
+
+    Signals
+    -------
+    elementClicked(index)
+        Instance index under a click (-1: none).
+    idleChanged(idle)
+        Whether the frame on screen is final (full quality, current drawing and view).
+    message(text)
+        A rendering error for the user.
+    """
+
+    elementClicked = Signal(int)
+    idleChanged = Signal(bool)
+    message = Signal(str)
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
+        self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+        self.setMouseTracking(False)
+        self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent)
+        self.drawing: Any = None
+        self.view = View()
+        self.color_mode = "none"
+        self.overlay_visible = False
+        self._overlay: Any = None
+        self._overlay_rect: QRectF | None = None
+        self._shown: Any = None  # the drawing as rendered (recoloured)
+        self._frame: Frame | None = None
+        self._renderers: dict[tuple[int, int, int], Any] = {}
+        self._fit_pending = True
+        self._user_moved = False
+        self._selected = -1
+        self._centers: np.ndarray | None = None
+        self._drag_start: QPointF | None = None
+        self._drag_view: View | None = None
+        self._press_pos: QPointF | None = None
+        self._space = False
+        self._interacting = False
+        self._interactive_source: Callable[[], bool] = lambda: False
+        self._idle = True
+        self.last_frame_seconds = 0.0
+        self.runner = LatestRunner(render_frame, name="lsys-render", parent=self)
+        self.runner.resultReady.connect(self._on_frame)
+        self.runner.failed.connect(self._on_render_failed)
+        self._settle = QTimer(self)
+        self._settle.setSingleShot(True)
+        self._settle.setInterval(SETTLE_MS)
+        self._settle.timeout.connect(self._end_interaction)
+
+    # -- public API ------------------------------------------------------------------------------------
+    def sizeHint(self) -> QSize:
+        """Prefer a roomy canvas."""
+        return QSize(800, 600)
+
+    def set_interactive_source(self, fn: Callable[[], bool]) -> None:
+        """Tell the canvas how to know a slider drag is in progress (renders drafts then)."""
+        self._interactive_source = fn
+
+    def set_drawing(self, drawing: Any) -> None:
+        """Show a new drawing (fits the view the first time after a file was opened)."""
+        self.drawing = drawing
+        self._shown = recolor(drawing, self.color_mode)
+        self._centers = None
+        self._selected = -1
+        if self._fit_pending and drawing is not None and len(drawing):
+            self._fit_pending = False
+            self.fit(render=False)
+        self.request_render()
+
+    def fit_on_next_drawing(self) -> None:
+        """Fit the view to the next drawing shown (a new file)."""
+        self._fit_pending = True
+
+    def set_color_mode(self, mode: str) -> None:
+        """Colour elements by ``"group"``, ``"rule"`` or not at all (``"none"``)."""
+        self.color_mode = mode
+        self._shown = recolor(self.drawing, mode)
+        self.request_render()
+
+    def set_overlay_svg(self, path: str | None) -> None:
+        """Use the SVG file ``path`` as the comparison overlay (None: no overlay)."""
+        self._overlay, self._overlay_rect = None, None
+        if path:
+            from PySide6.QtSvg import QSvgRenderer
+
+            renderer = QSvgRenderer(path)
+            if renderer.isValid():
+                self._overlay = renderer
+                self._overlay_rect = QRectF(renderer.viewBoxF())
+        if self.overlay_visible:
+            self.request_render()
+
+    def set_overlay_visible(self, visible: bool) -> None:
+        """Show or hide the translucent input overlay."""
+        self.overlay_visible = bool(visible)
+        self.request_render()
+
+    def fit(self, render: bool = True) -> None:
+        """Fit the drawing (or its canvas viewbox) into the widget."""
+        bounds = self._bounds()
+        if bounds is None:
+            return
+        x0, y0, x1, y1 = bounds
+        w, h = max(self.width(), 1), max(self.height(), 1)
+        bw, bh = max(x1 - x0, 1e-9), max(y1 - y0, 1e-9)
+        zoom = min(max(min((w - 40) / bw, (h - 40) / bh), MIN_ZOOM), MAX_ZOOM)
+        cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
+        self.view = View(zoom, w / 2 - cx * zoom, h / 2 - cy * zoom)
+        self._user_moved = False
+        if render:
+            self.request_render()
+
+    def zoom_100(self) -> None:
+        """Show the drawing at 100 % (one SVG unit per logical pixel), keeping the centre."""
+        self.zoom_at(1.0 / self.view.zoom, QPointF(self.width() / 2, self.height() / 2))
+
+    def zoom_by(self, factor: float) -> None:
+        """Zoom around the widget centre."""
+        self.zoom_at(factor, QPointF(self.width() / 2, self.height() / 2))
+
+    def zoom_at(self, factor: float, pos: QPointF) -> None:
+        """Zoom by ``factor`` keeping the document point under ``pos`` fixed."""
+        v = self.view
+        zoom = min(max(v.zoom * factor, MIN_ZOOM), MAX_ZOOM)
+        f = zoom / v.zoom
+        self.view = View(zoom, pos.x() - (pos.x() - v.ox) * f, pos.y() - (pos.y() - v.oy) * f)
+        self._user_moved = True
+        self._interact()
+
+    def pan_by(self, dx: float, dy: float) -> None:
+        """Move the view by ``(dx, dy)`` logical pixels."""
+        self.view = View(self.view.zoom, self.view.ox + dx, self.view.oy + dy)
+        self._user_moved = True
+        self._interact()
+
+    def is_idle(self) -> bool:
+        """Whether the frame on screen is the final one for the current drawing and view."""
+        return self._compute_idle()
+
+    def shutdown(self) -> None:
+        """Stop the render worker."""
+        self._settle.stop()
+        self.runner.shutdown()
+
+    def pick(self, pos: QPointF, radius: float = 12.0) -> int:
+        """Return the instance nearest to the widget point ``pos`` within ``radius`` pixels, or -1."""
+        d = self.drawing
+        if d is None or len(d) == 0:
+            return -1
+        if self._centers is None:
+            self._centers = core.instance_centers(d)
+        x, y = self.view.to_doc(pos.x(), pos.y())
+        dist = np.abs(self._centers - complex(x, y))
+        i = int(np.argmin(dist))
+        return (
+            i if dist[i] * self.view.zoom <= max(radius, core.instance_radius(d, i) * self.view.zoom) else -1
+        )
+
+    # -- rendering -----------------------------------------------------------------------------------
+    def _draft_now(self) -> bool:
+        return self._interacting or self._interactive_source()
+
+    def request_render(self, *, draft: bool | None = None) -> None:
+        """Ask for a frame of the current drawing and view (a draft while interacting)."""
+        if draft is None:
+            draft = self._draft_now()
+        self._set_idle(False)
+        if self._shown is None or self.width() <= 0 or self.height() <= 0:
+            self.runner.cancel()
+            self.update()
+            self._set_idle(self._compute_idle())
+            return
+        dpr = float(self.devicePixelRatioF())
+        w, h = max(1, round(self.width() * dpr)), max(1, round(self.height() * dpr))
+        slot = 1 - self._frame.slot if self._frame is not None else 0
+        key = (w, h, slot)
+        renderer = self._renderers.get(key)
+        if renderer is None:
+            for k in [k for k in self._renderers if k[2] == slot]:
+                del self._renderers[k]
+            renderer = self._renderers[key] = core.make_renderer(w, h)
+        overlay = self._overlay if self.overlay_visible else None
+        self.runner.submit(
+            RenderRequest(
+                self._shown, self.view, w, h, dpr, draft, renderer, slot, overlay, self._overlay_rect
+            )
+        )
+        self.update()
+
+    def request_full_quality(self) -> None:
+        """Render at full quality now (a gesture ended)."""
+        self._settle.stop()
+        self._interacting = False
+        self.request_render(draft=False)
+
+    def _interact(self) -> None:
+        self._interacting = True
+        self._settle.start()
+        self.request_render(draft=True)
+
+    def _end_interaction(self) -> None:
+        self._interacting = False
+        if self._interactive_source():
+            return  # the gesture's end triggers the full-quality frame
+        self.request_render(draft=False)
+
+    def _on_frame(self, frame: Frame) -> None:
+        self._frame = frame
+        self.last_frame_seconds = frame.seconds
+        self.update()
+        self._set_idle(self._compute_idle())
+        if not frame.draft or self._interacting or self._interactive_source():
+            return
+        if frame.drawing is self._shown and frame.view == self.view:
+            return
+        self.request_render(draft=False)
+
+    def _on_render_failed(self, message: str) -> None:
+        self.message.emit(f"Rendering failed: {message}")
+        self._set_idle(self._compute_idle())
+
+    def _compute_idle(self) -> bool:
+        if self.runner.busy:
+            return False
+        if self._shown is None:
+            return True
+        f = self._frame
+        dpr = float(self.devicePixelRatioF())
+        size = (max(1, round(self.width() * dpr)), max(1, round(self.height() * dpr)))
+        return (
+            f is not None
+            and not f.draft
+            and f.drawing is self._shown
+            and f.view == self.view
+            and f.size == size
+            and f.overlay == (self.overlay_visible and self._overlay is not None)
+        )
+
+    def _set_idle(self, idle: bool) -> None:
+        if idle != self._idle:
+            self._idle = idle
+            self.idleChanged.emit(idle)
+
+    # -- Qt events ------------------------------------------------------------------------------------
+    def paintEvent(self, event) -> None:
+        """Draw the last frame (transformed to the current view if it is older) and the selection."""
+        painter = QPainter(self)
+        painter.fillRect(self.rect(), QColor("#ffffff"))
+        f = self._frame
+        if f is not None:
+            if f.view == self.view:
+                painter.drawImage(QPointF(0, 0), f.image)
+            else:
+                s = self.view.zoom / f.view.zoom
+                painter.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform, False)
+                painter.setTransform(
+                    QTransform(s, 0, 0, s, self.view.ox - f.view.ox * s, self.view.oy - f.view.oy * s)
+                )
+                painter.drawImage(QPointF(0, 0), f.image)
+                painter.resetTransform()
+        if self._selected >= 0 and self._centers is not None and self._selected < len(self._centers):
+            c = self._centers[self._selected]
+            x, y = self.view.to_widget(c.real, c.imag)
+            r = max(6.0, core.instance_radius(self.drawing, self._selected) * self.view.zoom)
+            painter.setRenderHint(QPainter.RenderHint.Antialiasing)
+            painter.setPen(QPen(QColor("#d50000"), 2))
+            painter.drawEllipse(QPointF(x, y), r, r)
+        painter.end()
+
+    def resizeEvent(self, event) -> None:
+        """Re-render for the new size (re-fitting if the user has not moved the view)."""
+        super().resizeEvent(event)
+        if not self._user_moved and self.drawing is not None:
+            self.fit(render=False)
+        self._interact()
+
+    def wheelEvent(self, event) -> None:
+        """Zoom at the cursor."""
+        steps = event.angleDelta().y() / 120.0
+        if steps:
+            self.zoom_at(1.2**steps, event.position())
+        event.accept()
+
+    def keyPressEvent(self, event) -> None:
+        """Space held: drag pans."""
+        if event.key() == Qt.Key.Key_Space and not event.isAutoRepeat():
+            self._space = True
+            self.setCursor(Qt.CursorShape.OpenHandCursor)
+        else:
+            super().keyPressEvent(event)
+
+    def keyReleaseEvent(self, event) -> None:
+        """Space released."""
+        if event.key() == Qt.Key.Key_Space and not event.isAutoRepeat():
+            self._space = False
+            self.unsetCursor()
+        else:
+            super().keyReleaseEvent(event)
+
+    def mousePressEvent(self, event) -> None:
+        """Start a pan (any drag) or a click."""
+        self._press_pos = event.position()
+        self._drag_start = event.position()
+        self._drag_view = self.view
+        if self._space or event.button() == Qt.MouseButton.MiddleButton:
+            self.setCursor(Qt.CursorShape.ClosedHandCursor)
+
+    def mouseMoveEvent(self, event) -> None:
+        """Pan while dragging."""
+        if self._drag_start is None or self._drag_view is None:
+            return
+        delta = event.position() - self._drag_start
+        if self._press_pos is not None and delta.manhattanLength() < 4:
+            return
+        self._press_pos = None
+        v = self._drag_view
+        self.view = View(v.zoom, v.ox + delta.x(), v.oy + delta.y())
+        self._user_moved = True
+        self._interact()
+
+    def mouseReleaseEvent(self, event) -> None:
+        """A release without movement is a click: pick the element under it."""
+        if self._press_pos is not None and event.button() == Qt.MouseButton.LeftButton and not self._space:
+            self._selected = self.pick(event.position())
+            self.update()
+            self.elementClicked.emit(self._selected)
+        self._drag_start = self._drag_view = self._press_pos = None
+        if not self._space:
+            self.unsetCursor()
+
+    def _bounds(self) -> tuple[float, float, float, float] | None:
+        d = self.drawing
+        if d is None:
+            return None
+        if len(d):
+            return core.drawing_bounds(d)
+        if d.viewbox is not None:
+            x, y, w, h = d.viewbox
+            return x, y, x + w, y + h
+        return None

@@ -1,0 +1,256 @@
+"""The editor's door to ``lsys_core``: every computation the widgets ask for goes through here.
+
+The functions only forward to the library (imported on first use, so the window appears
+before scikit-learn and friends are loaded) and convert plain values (settings dicts,
+file reads) at the boundary.  Nothing here computes geometry or grammars.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from typing import Any
+
+from PySide6.QtGui import QImage
+
+from lsys_core.derive import Randomize
+from lsys_core.errors import Cancelled, LsysError
+
+__all__ = [
+    "RENDER_FORMAT",
+    "Cancelled",
+    "axiom_count",
+    "default_settings",
+    "drawing_bounds",
+    "export_png",
+    "export_svg",
+    "format_grammar",
+    "infer",
+    "instance_centers",
+    "instance_radius",
+    "list_params",
+    "load_svg",
+    "make_renderer",
+    "parse_grammar",
+    "randomize_from_dict",
+    "read_text",
+    "relaxed_settings",
+    "replace_terminal",
+    "replace_with_terminal",
+    "set_axiom_count",
+    "set_param",
+    "settings_from_dict",
+    "symmetrize",
+    "write_atomic",
+]
+
+
+def load_svg(path: str) -> Any:
+    """Load an SVG file into a Scene (``lsys_core.svg.parse.load_svg``)."""
+    from lsys_core.svg.parse import load_svg as _load
+
+    return _load(path)
+
+
+def infer(scene: Any, settings: Any, *, cancel=None, progress=None) -> Any:
+    """Infer a grammar for ``scene`` (``lsys_core.pipeline.infer``)."""
+    from lsys_core.pipeline import infer as _infer
+
+    return _infer(scene, settings, cancel=cancel, progress=progress)
+
+
+def symmetrize(scene: Any, settings: Any, *, cancel=None, progress=None) -> Any:
+    """Infer with relaxed clustering tolerance (``lsys_core.pipeline.symmetrize``)."""
+    from lsys_core.pipeline import symmetrize as _sym
+
+    return _sym(scene, settings, cancel=cancel, progress=progress)
+
+
+def _settings_type() -> type:
+    from lsys_core.pipeline import InferenceSettings
+
+    return InferenceSettings
+
+
+def default_settings() -> Any:
+    """Return the default ``InferenceSettings`` (None while the pipeline is unavailable)."""
+    try:
+        return _settings_type()()
+    except ImportError:
+        return None
+
+
+def relaxed_settings(settings: Any) -> Any:
+    """Return the relaxed variant of ``settings`` used by symmetrize."""
+    return settings.relaxed()
+
+
+def settings_from_dict(values: dict[str, Any]) -> Any:
+    """Build ``InferenceSettings`` from a dict, ignoring unknown keys (recovery files)."""
+    cls = _settings_type()
+    names = {f.name for f in dataclasses.fields(cls)}
+    return cls(**{k: v for k, v in values.items() if k in names})
+
+
+def randomize_from_dict(values: dict[str, Any] | None) -> Randomize | None:
+    """Build a ``Randomize`` from a dict (None stays None)."""
+    if not values:
+        return None
+    names = {f.name for f in dataclasses.fields(Randomize)}
+    return Randomize(**{k: v for k, v in values.items() if k in names})
+
+
+def parse_grammar(text: str) -> Any:
+    """Parse ``.lsys`` text (raises ``GrammarSyntaxError`` with line and column)."""
+    from lsys_core.grammar import parse_grammar as _parse
+
+    return _parse(text)
+
+
+def format_grammar(grammar: Any) -> str:
+    """Format a grammar as ``.lsys`` text."""
+    from lsys_core.grammar import format_grammar as _format
+
+    return _format(grammar)
+
+
+def list_params(grammar: Any) -> list:
+    """List the numeric parameters of a grammar (``Param(key, label, value, kind)``)."""
+    from lsys_core.grammar import list_params as _list
+
+    return _list(grammar)
+
+
+def set_param(grammar: Any, key: str, value: float) -> Any:
+    """Return ``grammar`` with one parameter changed."""
+    from lsys_core.grammar import set_param as _set
+
+    return _set(grammar, key, value)
+
+
+def replace_terminal(grammar: Any, name: str, path_d: str, style: str) -> Any:
+    """Return ``grammar`` with terminal ``name`` drawing another shape."""
+    from lsys_core.edit import replace_terminal as _replace
+
+    return _replace(grammar, name, path_d, style)
+
+
+def replace_with_terminal(grammar: Any, nonterminal: str, terminal: str) -> Any:
+    """Return ``grammar`` with every use of a non-terminal replaced by a terminal."""
+    from lsys_core.edit import replace_with_terminal as _replace
+
+    return _replace(grammar, nonterminal, terminal)
+
+
+def set_axiom_count(grammar: Any, m: int) -> Any:
+    """Return ``grammar`` with the axiom's counter set to ``m``."""
+    from lsys_core.edit import set_axiom_count as _set
+
+    return _set(grammar, m)
+
+
+def export_svg(drawing: Any, path: str) -> None:
+    """Write the drawing as an SVG file (atomically)."""
+    from lsys_core.svg.export import export_svg as _export
+
+    _export(drawing, path)
+
+
+def export_png(drawing: Any, path: str, **options: Any) -> None:
+    """Render the drawing into a PNG file."""
+    from lsys_core.render import render_png
+
+    render_png(drawing, path, **options)
+
+
+#: Pixel format of ``Renderer.draw``'s RGBA array (premultiplied alpha, as skia stores it).
+RENDER_FORMAT = QImage.Format.Format_RGBA8888_Premultiplied
+
+
+def make_renderer(width: int, height: int) -> Any:
+    """Return a ``lsys_core.render.Renderer`` drawing into a ``width`` × ``height`` surface."""
+    from lsys_core.render import Renderer
+
+    return Renderer(width, height)
+
+
+def write_atomic(path: str, data: bytes) -> None:
+    """Write ``data`` to ``path`` atomically (``lsys_core.io.write_atomic``)."""
+    from lsys_core.io import write_atomic as _write
+
+    _write(path, data)
+
+
+def read_text(path: str) -> str:
+    """Read a UTF-8 text file, reporting failures as one-line ``LsysError`` s."""
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise LsysError(f"cannot read {path}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise LsysError(f"cannot read {path}: not UTF-8 text") from None
+
+
+# -- display helpers (picking, fitting) ---------------------------------------------------------------
+_TERMINAL_DISCS: dict[tuple[str, ...], tuple[Any, Any]] = {}
+
+
+def _terminal_discs(terminals: tuple) -> tuple[Any, Any]:
+    """Return the centre (complex) and radius of every terminal's bounding box in its local frame."""
+    import numpy as np
+
+    from lsys_core.svg.pathdata import cubics_bounds, cubics_from_d
+
+    key = tuple(t.path for t in terminals)
+    cached = _TERMINAL_DISCS.get(key)
+    if cached is None:
+        centers = np.zeros(len(terminals), complex)
+        radii = np.zeros(len(terminals))
+        for i, t in enumerate(terminals):
+            try:
+                cubics = cubics_from_d(t.path)[0]
+            except LsysError:
+                continue
+            if len(cubics):
+                x0, y0, x1, y1 = cubics_bounds(cubics)
+                centers[i] = complex((x0 + x1) / 2, (y0 + y1) / 2)
+                radii[i] = 0.5 * float(np.hypot(x1 - x0, y1 - y0))
+        if len(_TERMINAL_DISCS) > 64:
+            _TERMINAL_DISCS.clear()
+        cached = _TERMINAL_DISCS[key] = (centers, radii)
+    return cached
+
+
+def instance_centers(drawing: Any) -> Any:
+    """Return the centre of every instance's bounding disc in document coordinates (for picking)."""
+    centers, _ = _terminal_discs(drawing.terminals)
+    return drawing.a * centers[drawing.symbol] + drawing.b
+
+
+def instance_radius(drawing: Any, index: int) -> float:
+    """Return the radius of instance ``index``'s bounding disc in document units."""
+    _, radii = _terminal_discs(drawing.terminals)
+    return float(abs(drawing.a[index]) * radii[drawing.symbol[index]])
+
+
+def drawing_bounds(drawing: Any) -> tuple[float, float, float, float]:
+    """Return ``(x0, y0, x1, y1)`` enclosing every instance's bounding disc."""
+    import numpy as np
+
+    centers, radii = _terminal_discs(drawing.terminals)
+    c = drawing.a * centers[drawing.symbol] + drawing.b
+    r = np.abs(drawing.a) * radii[drawing.symbol]
+    return (
+        float((c.real - r).min()),
+        float((c.imag - r).min()),
+        float((c.real + r).max()),
+        float((c.imag + r).max()),
+    )
+
+
+def axiom_count(grammar: Any) -> int | None:
+    """Return the axiom's counter m (the alias ``m`` of ``set_param``), or None if it has none."""
+    for p in list_params(grammar):
+        if p.kind == "count" and p.key.startswith("axiom."):
+            return int(p.value)
+    return None

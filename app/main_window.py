@@ -1,0 +1,631 @@
+"""The main window: canvas, docks, menus, files, status bar and the wiring between them.
+
+Widgets show the :class:`~app.document.Document` and forward edits to it; every action here is
+a call on the document or into ``lsys_core``.  Errors reach the user as a message bar above the
+canvas (and in the status bar), never as a crash or a modal box that stops the event loop.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+from PySide6.QtCore import QSettings, Qt, QTimer, Signal
+from PySide6.QtGui import QAction, QActionGroup, QCloseEvent, QKeySequence
+from PySide6.QtWidgets import (
+    QDockWidget,
+    QFileDialog,
+    QHBoxLayout,
+    QLabel,
+    QMainWindow,
+    QMessageBox,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from lsys_core.errors import LsysError
+
+from . import core
+from .canvas import Canvas
+from .dialogs import RandomizeDialog, ReplaceDialog
+from .document import Document
+from .inference_panel import InferencePanel
+from .params_panel import ParamsPanel
+from .recovery import Recovery
+from .rules_panel import RulesPanel
+
+__all__ = ["MainWindow", "MessageBar"]
+
+MAX_RECENT = 10
+FILE_FILTER = "SVG or L-system (*.svg *.lsys);;SVG files (*.svg);;L-system rules (*.lsys);;All files (*)"
+
+
+class MessageBar(QWidget):
+    """A dismissable line above the canvas showing the latest error or note."""
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.label = QLabel(self)
+        self.label.setWordWrap(True)
+        self.label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        close = QToolButton(self)
+        close.setText("✕")
+        close.setAutoRaise(True)
+        close.clicked.connect(self.hide)
+        layout = QHBoxLayout(self)
+        layout.setContentsMargins(8, 4, 4, 4)
+        layout.addWidget(self.label, 1)
+        layout.addWidget(close)
+        self.setAutoFillBackground(True)
+        self.setStyleSheet("MessageBar { background: #fdecea; } QLabel { color: #611a15; }")
+        self.hide()
+
+    def show_message(self, text: str) -> None:
+        """Show ``text`` (replacing the previous message)."""
+        self.label.setText(text)
+        self.show()
+
+    def text(self) -> str:
+        """Return the message shown (empty when hidden)."""
+        return self.label.text() if self.isVisible() else ""
+
+
+class MainWindow(QMainWindow):
+    """The editor window.
+
+    Parameters
+    ----------
+    settings : QSettings, optional
+        Where layout and recent files are kept (default: the application's settings).
+    restore_layout : bool
+        Restore the saved window geometry and dock layout.
+    autosave : bool
+        Autosave the document for crash recovery.
+
+    Signals
+    -------
+    idle()
+        Emitted when no computation is pending and the canvas shows the final rendering.
+    """
+
+    idle = Signal()
+
+    def __init__(
+        self, settings: QSettings | None = None, *, restore_layout: bool = True, autosave: bool = True
+    ):
+        super().__init__()
+        self.settings = settings or QSettings()
+        self.doc = Document(self)
+        self.setAcceptDrops(True)
+        self.resize(1400, 900)
+
+        self.canvas = Canvas(self)
+        self.message_bar = MessageBar(self)
+        central = QWidget(self)
+        lay = QVBoxLayout(central)
+        lay.setContentsMargins(0, 0, 0, 0)
+        lay.setSpacing(0)
+        lay.addWidget(self.message_bar)
+        lay.addWidget(self.canvas, 1)
+        self.setCentralWidget(central)
+
+        self.rules_panel = RulesPanel(self)
+        self.params_panel = ParamsPanel(self)
+        self.inference_panel = InferencePanel(self)
+        self.rules_dock = self._dock(
+            "Rules", "rules", self.rules_panel, Qt.DockWidgetArea.RightDockWidgetArea
+        )
+        self.params_dock = self._dock(
+            "Parameters", "params", self.params_panel, Qt.DockWidgetArea.RightDockWidgetArea
+        )
+        self.inference_dock = self._dock(
+            "Inference", "inference", self.inference_panel, Qt.DockWidgetArea.LeftDockWidgetArea
+        )
+        self.resizeDocks([self.rules_dock, self.params_dock], [460, 380], Qt.Orientation.Vertical)
+        self.resizeDocks([self.rules_dock, self.inference_dock], [520, 320], Qt.Orientation.Horizontal)
+
+        self._status_labels = {
+            k: QLabel(self) for k in ("elements", "symbols", "rules", "compression", "time")
+        }
+        for label in self._status_labels.values():
+            self.statusBar().addPermanentWidget(label)
+
+        self._create_actions()
+        self._create_menus()
+        self._connect()
+        self.inference_panel.set_settings(self.doc.settings)
+        self._update_actions()
+        self._update_status()
+        self._update_title()
+
+        self._idle_timer = QTimer(self)
+        self._idle_timer.setSingleShot(True)
+        self._idle_timer.setInterval(30)
+        self._idle_timer.timeout.connect(self._check_idle)
+
+        self.recovery = Recovery(self.doc, parent=self) if autosave else None
+        if restore_layout:
+            geometry = self.settings.value("window/geometry")
+            state = self.settings.value("window/state")
+            if geometry is not None:
+                self.restoreGeometry(geometry)
+            if state is not None:
+                self.restoreState(state)
+
+    # -- construction ---------------------------------------------------------------------------------
+    def _dock(self, title: str, name: str, widget: QWidget, area: Qt.DockWidgetArea) -> QDockWidget:
+        dock = QDockWidget(title, self)
+        dock.setObjectName(f"dock-{name}")
+        dock.setWidget(widget)
+        self.addDockWidget(area, dock)
+        return dock
+
+    def _action(self, text: str, slot, shortcut: Any = None, tip: str = "") -> QAction:
+        action = QAction(text, self)
+        if shortcut is not None:
+            action.setShortcut(QKeySequence(shortcut))
+        if tip:
+            action.setStatusTip(tip)
+        action.triggered.connect(slot)
+        return action
+
+    def _create_actions(self) -> None:
+        K = QKeySequence.StandardKey
+        self.act_open = self._action("&Open…", self.open_dialog, K.Open, "Open an SVG or .lsys file")
+        self.act_save = self._action("&Save", self.save, K.Save, "Save the rules as .lsys")
+        self.act_save_as = self._action("Save &As…", self.save_as, K.SaveAs)
+        self.act_export_svg = self._action("Export S&VG…", self.export_svg_dialog, "Ctrl+E")
+        self.act_export_png = self._action("Export &PNG…", self.export_png_dialog, "Ctrl+Shift+E")
+        self.act_quit = self._action("&Quit", self.close, K.Quit)
+        self.act_undo = self.doc.undo_stack.createUndoAction(self, "&Undo")
+        self.act_undo.setShortcut(QKeySequence(K.Undo))
+        self.act_redo = self.doc.undo_stack.createRedoAction(self, "&Redo")
+        self.act_redo.setShortcuts([QKeySequence(K.Redo), QKeySequence("Ctrl+Y")])
+        self.act_symmetrize = self._action(
+            "S&ymmetrize", self.doc.symmetrize, "Ctrl+Shift+Y", "Infer again with relaxed tolerance"
+        )
+        self.act_randomize = self._action("&Randomize…", self.randomize_dialog, "Ctrl+R")
+        self.act_unrandomize = self._action("Clear Randomization", lambda: self.doc.set_randomize(None))
+        self.act_replace = self._action("Re&place Symbol…", self.replace_dialog, "Ctrl+Shift+R")
+        self.act_grow = self._action(
+            "&Grow", lambda: self.change_count(+1), "Ctrl+]", "Increase the axiom's m"
+        )
+        self.act_shrink = self._action(
+            "S&hrink", lambda: self.change_count(-1), "Ctrl+[", "Decrease the axiom's m"
+        )
+        self.act_fit = self._action("&Fit", self.canvas.fit, "Ctrl+0")
+        self.act_100 = self._action("&100 %", self.canvas.zoom_100, "Ctrl+1")
+        self.act_zoom_in = self._action("Zoom &In", lambda: self.canvas.zoom_by(1.25), K.ZoomIn)
+        self.act_zoom_out = self._action("Zoom &Out", lambda: self.canvas.zoom_by(0.8), K.ZoomOut)
+        self.act_overlay = self._action("Show &Input Overlay", self.canvas.set_overlay_visible, "Ctrl+I")
+        self.act_overlay.setCheckable(True)
+        self.color_group = QActionGroup(self)
+        self.act_colors = {}
+        for mode, text in (
+            ("none", "Original Colours"),
+            ("group", "Colour by Similarity Group"),
+            ("rule", "Colour by Rule"),
+        ):
+            act = QAction(text, self, checkable=True)
+            act.setData(mode)
+            act.triggered.connect(lambda _checked=False, m=mode: self.canvas.set_color_mode(m))
+            self.color_group.addAction(act)
+            self.act_colors[mode] = act
+        self.act_colors["none"].setChecked(True)
+
+    def _create_menus(self) -> None:
+        bar = self.menuBar()
+        file_menu = bar.addMenu("&File")
+        file_menu.addAction(self.act_open)
+        self.recent_menu = file_menu.addMenu("Open &Recent")
+        self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
+        file_menu.addSeparator()
+        for act in (self.act_save, self.act_save_as):
+            file_menu.addAction(act)
+        file_menu.addSeparator()
+        for act in (self.act_export_svg, self.act_export_png):
+            file_menu.addAction(act)
+        file_menu.addSeparator()
+        file_menu.addAction(self.act_quit)
+        edit = bar.addMenu("&Edit")
+        for act in (self.act_undo, self.act_redo):
+            edit.addAction(act)
+        edit.addSeparator()
+        for act in (
+            self.act_symmetrize,
+            self.act_randomize,
+            self.act_unrandomize,
+            self.act_replace,
+            self.act_grow,
+            self.act_shrink,
+        ):
+            edit.addAction(act)
+        view = bar.addMenu("&View")
+        for act in (self.act_fit, self.act_100, self.act_zoom_in, self.act_zoom_out):
+            view.addAction(act)
+        view.addSeparator()
+        view.addAction(self.act_overlay)
+        for act in self.act_colors.values():
+            view.addAction(act)
+        view.addSeparator()
+        for dock in (self.rules_dock, self.params_dock, self.inference_dock):
+            view.addAction(dock.toggleViewAction())
+        tools = self.addToolBar("Main")
+        tools.setObjectName("toolbar-main")
+        for act in (
+            self.act_open,
+            self.act_save,
+            self.act_undo,
+            self.act_redo,
+            self.act_symmetrize,
+            self.act_randomize,
+            self.act_replace,
+            self.act_shrink,
+            self.act_grow,
+            self.act_fit,
+        ):
+            tools.addAction(act)
+
+    def _connect(self) -> None:
+        d = self.doc
+        d.textChanged.connect(self.rules_panel.set_text)
+        d.grammarError.connect(self.rules_panel.set_error)
+        d.grammarError.connect(self._on_grammar_error)
+        d.grammarChanged.connect(self._on_grammar_changed)
+        d.drawingChanged.connect(self.canvas.set_drawing)
+        d.drawingChanged.connect(self._update_status)
+        d.settingsChanged.connect(self.inference_panel.set_settings)
+        d.sceneChanged.connect(self._on_scene_changed)
+        d.inferenceStarted.connect(lambda: self.inference_panel.set_running(True))
+        d.inferenceProgress.connect(self.inference_panel.set_progress)
+        d.inferenceFinished.connect(self._on_inference_finished)
+        d.message.connect(self.show_message)
+        d.pathChanged.connect(self._update_title)
+        d.pathChanged.connect(self._update_actions)
+        d.undo_stack.cleanChanged.connect(self._update_title)
+        d.busyChanged.connect(self._schedule_idle_check)
+        d.gestureFinished.connect(self.canvas.request_full_quality)
+        self.canvas.idleChanged.connect(self._schedule_idle_check)
+        self.canvas.elementClicked.connect(self._on_element_clicked)
+        self.canvas.message.connect(self.show_message)
+        self.rules_panel.textEdited.connect(d.edit_text)
+        self.rules_panel.editor.undoRequested.connect(d.undo_stack.undo)
+        self.rules_panel.editor.redoRequested.connect(d.undo_stack.redo)
+        self.params_panel.paramEdited.connect(d.set_param)
+        self.params_panel.dragStarted.connect(d.begin_gesture)
+        self.params_panel.dragFinished.connect(d.end_gesture)
+        self.inference_panel.settingsEdited.connect(d.set_settings)
+        self.inference_panel.dragStarted.connect(d.begin_gesture)
+        self.inference_panel.dragFinished.connect(d.end_gesture)
+        self.inference_panel.cancelRequested.connect(d.cancel_inference)
+        self.inference_panel.reinferRequested.connect(d.reinfer)
+        self.canvas.set_interactive_source(lambda: d.interactive)
+
+    # -- messages and state -------------------------------------------------------------------------
+    def show_message(self, text: str) -> None:
+        """Show an error or note above the canvas and in the status bar."""
+        self.message_bar.show_message(text)
+        self.statusBar().showMessage(text, 10000)
+
+    def _on_grammar_error(self, error: Any) -> None:
+        self.params_panel.setEnabled(error is None)
+        self._update_actions()
+
+    def _on_grammar_changed(self, grammar: Any) -> None:
+        try:
+            self.params_panel.set_params(core.list_params(grammar))
+        except LsysError as exc:
+            self.show_message(str(exc))
+        self._update_status()
+        self._update_actions()
+
+    def _on_scene_changed(self) -> None:
+        self.canvas.set_overlay_svg(self.doc.scene_path)
+        if self.doc.scene_path:
+            self.add_recent(self.doc.scene_path)
+            self.canvas.fit_on_next_drawing()
+        self.message_bar.hide()
+        self._update_actions()
+        self._update_title()
+
+    def _on_inference_finished(self) -> None:
+        self.inference_panel.set_running(False)
+        self._update_status()
+
+    def _on_element_clicked(self, index: int) -> None:
+        drawing, grammar = self.doc.drawing, self.doc.grammar
+        if drawing is None or grammar is None or index < 0:
+            self.rules_panel.highlight_rule(None)
+            return
+        rule = int(drawing.rule[index])
+        name = "axiom" if rule < 0 or rule >= len(grammar.rules) else grammar.rules[rule].name
+        self.rules_panel.highlight_rule(name)
+        self.statusBar().showMessage(f"element {index} drawn by {name}", 5000)
+
+    def _update_actions(self, *_args: Any) -> None:
+        d = self.doc
+        has_grammar = d.grammar is not None
+        self.act_symmetrize.setEnabled(d.can_infer)
+        self.inference_panel.setEnabled(d.can_infer)
+        for act in (
+            self.act_randomize,
+            self.act_replace,
+            self.act_grow,
+            self.act_shrink,
+            self.act_export_svg,
+            self.act_export_png,
+            self.act_save,
+            self.act_save_as,
+        ):
+            act.setEnabled(has_grammar)
+
+    def _update_status(self, *_args: Any) -> None:
+        s = self.doc.stats()
+        labels = self._status_labels
+
+        def show(key: str, text: str | None) -> None:
+            labels[key].setText(text or "")
+            labels[key].setVisible(bool(text))
+
+        show("elements", f"{s['elements']:,} elements" if s["elements"] is not None else None)
+        if s["terminals"] is not None:
+            show("symbols", f"{s['terminals']} terminals, {s['nonterminals']} non-terminals")
+            show("rules", f"{s['rules']} rules")
+        else:
+            show("symbols", None)
+            show("rules", None)
+        show("compression", f"compression {s['compression']:.1f}×" if s["compression"] else None)
+        show("time", f"inference {s['seconds']:.2f} s" if s["seconds"] is not None else None)
+
+    def _update_title(self, *_args: Any) -> None:
+        self.setWindowTitle(f"{self.doc.display_name()}[*] — L-system Editor")
+        self.setWindowModified(self.doc.modified)
+
+    # -- idle (used by --screenshot and tests) -----------------------------------------------------------
+    def is_idle(self) -> bool:
+        """Whether nothing is pending: no inference, parse or derivation, and the canvas is final."""
+        return not self.doc.busy and self.canvas.is_idle()
+
+    def _schedule_idle_check(self, *_args: Any) -> None:
+        self._idle_timer.start()
+
+    def _check_idle(self) -> None:
+        if self.is_idle():
+            self.idle.emit()
+
+    # -- files ----------------------------------------------------------------------------------------
+    def open_path(self, path: str) -> None:
+        """Open an SVG (inferring its rules) or an .lsys file; errors become messages."""
+        if not self.maybe_save():
+            return
+        path = str(path)
+        if not os.path.isfile(path):
+            self.show_message(f"Cannot open {path}: no such file")
+            return
+        if path.lower().endswith(".lsys"):
+            try:
+                self.doc.open_lsys(path)
+            except LsysError as exc:
+                self.show_message(f"Could not open {os.path.basename(path)}: {exc}")
+                return
+            self.add_recent(path)
+            self.canvas.fit_on_next_drawing()
+            self.message_bar.hide()
+        else:
+            self.statusBar().showMessage(f"Opening {os.path.basename(path)}…")
+            self.doc.open_svg(path)
+
+    def open_dialog(self) -> None:
+        """Ask for a file and open it."""
+        path, _ = QFileDialog.getOpenFileName(self, "Open", self._last_dir(), FILE_FILTER)
+        if path:
+            self.open_path(path)
+
+    def save(self) -> bool:
+        """Save the rules to the current .lsys file (asks for a name if there is none)."""
+        if not self.doc.path:
+            return self.save_as()
+        return self._save_to(self.doc.path)
+
+    def save_as(self) -> bool:
+        """Ask for a file name and save the rules there."""
+        suggestion = self.doc.path or (
+            str(Path(self.doc.scene_path).with_suffix(".lsys"))
+            if self.doc.scene_path
+            else os.path.join(self._last_dir(), "untitled.lsys")
+        )
+        path, _ = QFileDialog.getSaveFileName(self, "Save rules", suggestion, "L-system rules (*.lsys)")
+        return bool(path) and self._save_to(path)
+
+    def _save_to(self, path: str) -> bool:
+        try:
+            self.doc.save(path)
+        except LsysError as exc:
+            self.show_message(f"Could not save: {exc}")
+            return False
+        self.add_recent(path)
+        self.statusBar().showMessage(f"Saved {path}", 5000)
+        return True
+
+    def export_svg(self, path: str) -> bool:
+        """Write the current drawing as SVG; errors become messages."""
+        return self._export(core.export_svg, path)
+
+    def export_png(self, path: str) -> bool:
+        """Render the current drawing into a PNG file; errors become messages."""
+        return self._export(core.export_png, path)
+
+    def _export(self, fn, path: str) -> bool:
+        if self.doc.drawing is None:
+            self.show_message("Nothing to export yet.")
+            return False
+        try:
+            fn(self.doc.drawing, path)
+        except LsysError as exc:
+            self.show_message(f"Could not export: {exc}")
+            return False
+        self.statusBar().showMessage(f"Exported {path}", 5000)
+        return True
+
+    def export_svg_dialog(self) -> None:
+        """Ask for a file name and export SVG."""
+        path, _ = QFileDialog.getSaveFileName(
+            self, "Export SVG", self._export_name(".svg"), "SVG files (*.svg)"
+        )
+        if path:
+            self.export_svg(path)
+
+    def export_png_dialog(self) -> None:
+        """Ask for a file name and export PNG."""
+        path, _ = QFileDialog.getSaveFileName(
+            self, "Export PNG", self._export_name(".png"), "PNG images (*.png)"
+        )
+        if path:
+            self.export_png(path)
+
+    def _export_name(self, suffix: str) -> str:
+        base = self.doc.path or self.doc.scene_path
+        if base:
+            return str(Path(base).with_name(Path(base).stem + "-derived" + suffix))
+        return os.path.join(self._last_dir(), "derived" + suffix)
+
+    def _last_dir(self) -> str:
+        recent = self.recent_files()
+        return os.path.dirname(recent[0]) if recent else os.getcwd()
+
+    # -- recent files ---------------------------------------------------------------------------------
+    def recent_files(self) -> list[str]:
+        """Return the recent files, newest first."""
+        value = self.settings.value("recentFiles", [])
+        if isinstance(value, str):
+            value = [value]
+        return [str(v) for v in (value or [])]
+
+    def add_recent(self, path: str) -> None:
+        """Put ``path`` first in the recent-files list."""
+        path = os.path.abspath(path)
+        files = [path] + [f for f in self.recent_files() if f != path]
+        self.settings.setValue("recentFiles", files[:MAX_RECENT])
+
+    def _fill_recent_menu(self) -> None:
+        self.recent_menu.clear()
+        files = self.recent_files()
+        for i, path in enumerate(files):
+            act = self.recent_menu.addAction(f"&{i + 1} {os.path.basename(path)}")
+            act.setToolTip(path)
+            act.triggered.connect(lambda _checked=False, p=path: self.open_path(p))
+        if not files:
+            self.recent_menu.addAction("(none)").setEnabled(False)
+        else:
+            self.recent_menu.addSeparator()
+            self.recent_menu.addAction("Clear", lambda: self.settings.setValue("recentFiles", []))
+
+    # -- actions ---------------------------------------------------------------------------------------
+    def randomize_dialog(self) -> None:
+        """Show the randomize dialog; Cancel restores the previous randomization."""
+        dialog = RandomizeDialog(self.doc.randomize, self)
+        dialog.applied.connect(self.doc.set_randomize)
+        if dialog.exec():
+            self.doc.set_randomize(dialog.value())
+        else:
+            self.doc.set_randomize(dialog.initial)
+
+    def replace_dialog(self) -> None:
+        """Show the replace-symbol dialog and apply the choice."""
+        if self.doc.grammar is None:
+            return
+        inst = getattr(self.doc.result, "instancing", None)
+        dialog = ReplaceDialog(self.doc.grammar, getattr(inst, "terminals", ()), core.shape_from_svg, self)
+        if dialog.exec():
+            choice = dialog.choice()
+            if choice is not None:
+                self.replace_symbol(choice)
+
+    def replace_symbol(self, choice) -> None:
+        """Apply a :class:`~app.dialogs.ReplaceChoice` to the grammar (undoable)."""
+        g = self.doc.grammar
+        try:
+            if choice.kind == "nonterminal":
+                new = core.replace_with_terminal(g, choice.target, choice.terminal)
+                label = f"Replace {choice.target} by {choice.terminal}"
+            else:
+                new = core.replace_terminal(g, choice.target, choice.path, choice.style)
+                label = f"Replace shape of {choice.target}"
+        except LsysError as exc:
+            self.show_message(f"Cannot replace: {exc}")
+            return
+        self.doc.apply_grammar(new, label)
+
+    def change_count(self, step: int) -> None:
+        """Grow (``step > 0``) or shrink the structure by changing the axiom's counter m."""
+        g = self.doc.grammar
+        if g is None:
+            return
+        try:
+            m = core.axiom_count(g)
+            if m is None:
+                self.show_message("The axiom has no counter m to change.")
+                return
+            new_m = max(0, m + step * max(1, round(abs(m) * 0.1)))
+            self.doc.apply_grammar(core.set_axiom_count(g, new_m), "Grow" if step > 0 else "Shrink")
+        except LsysError as exc:
+            self.show_message(str(exc))
+
+    # -- drag and drop, close ---------------------------------------------------------------------------
+    def dragEnterEvent(self, event) -> None:
+        """Accept dragged .svg and .lsys files."""
+        if any(
+            u.isLocalFile() and u.toLocalFile().lower().endswith((".svg", ".lsys"))
+            for u in event.mimeData().urls()
+        ):
+            event.acceptProposedAction()
+
+    def dropEvent(self, event) -> None:
+        """Open the first dropped .svg or .lsys file."""
+        for url in event.mimeData().urls():
+            path = url.toLocalFile()
+            if url.isLocalFile() and path.lower().endswith((".svg", ".lsys")):
+                event.acceptProposedAction()
+                self.open_path(path)
+                return
+
+    def ask_save_changes(self) -> QMessageBox.StandardButton:
+        """Ask whether to save unsaved changes (Save, Discard or Cancel)."""
+        B = QMessageBox.StandardButton
+        return QMessageBox.question(
+            self,
+            "Unsaved changes",
+            f"Save the changes to {self.doc.display_name()}?",
+            B.Save | B.Discard | B.Cancel,
+            B.Save,
+        )
+
+    def maybe_save(self) -> bool:
+        """Offer to save unsaved changes; return False if the user cancelled."""
+        if not self.doc.modified:
+            return True
+        answer = self.ask_save_changes()
+        if answer == QMessageBox.StandardButton.Save:
+            return self.save()
+        return answer == QMessageBox.StandardButton.Discard
+
+    def closeEvent(self, event: QCloseEvent) -> None:
+        """Offer to save, keep the layout, stop the workers and remove the recovery file."""
+        if not self.maybe_save():
+            event.ignore()
+            return
+        self.settings.setValue("window/geometry", self.saveGeometry())
+        self.settings.setValue("window/state", self.saveState())
+        self.shutdown()
+        event.accept()
+
+    def shutdown(self) -> None:
+        """Stop every background computation (idempotent)."""
+        self._idle_timer.stop()
+        self.doc.shutdown()
+        self.canvas.shutdown()
+        if self.recovery is not None:
+            self.recovery.close()
+            self.recovery = None

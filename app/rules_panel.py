@@ -1,0 +1,321 @@
+"""The rules panel: the grammar as ``.lsys`` text with highlighting, line numbers and error markers.
+
+The editor forwards every keystroke to the document (which records it on the undo stack and
+re-derives after a short pause) and shows the document's text, its parse error (a wavy
+underline at ``line:column``, a marker in the line-number gutter and the message below), and
+the rule a clicked element came from.  Undo/redo keys go to the document's undo stack, not to
+the text widget's own history.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+from PySide6.QtCore import QRect, QRegularExpression, QSize, Qt, Signal
+from PySide6.QtGui import (
+    QColor,
+    QFont,
+    QFontDatabase,
+    QKeySequence,
+    QPainter,
+    QSyntaxHighlighter,
+    QTextCharFormat,
+    QTextCursor,
+    QTextFormat,
+)
+from PySide6.QtWidgets import QLabel, QPlainTextEdit, QTextEdit, QVBoxLayout, QWidget
+
+__all__ = ["LsysHighlighter", "RulesEditor", "RulesPanel"]
+
+KEYWORDS = ("lsys", "canvas", "viewbox", "size", "terminal", "style", "mirror", "axiom")
+
+
+def _fmt(color: str, *, bold: bool = False, italic: bool = False) -> QTextCharFormat:
+    f = QTextCharFormat()
+    f.setForeground(QColor(color))
+    if bold:
+        f.setFontWeight(QFont.Weight.Bold)
+    f.setFontItalic(italic)
+    return f
+
+
+class LsysHighlighter(QSyntaxHighlighter):
+    """Colour keywords, symbols, turtle commands, numbers, strings, conditions and comments."""
+
+    RULES = (
+        (r"\b(?:" + "|".join(KEYWORDS) + r")\b", _fmt("#7b1fa2", bold=True)),
+        (r"\b[A-Z][A-Za-z0-9_]*\b", _fmt("#1565c0", bold=True)),
+        (r"(?<![A-Za-z0-9_])(?:f|[+\-*])(?=\s*\()", _fmt("#2e7d32", bold=True)),
+        (r"(?<![A-Za-z_])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?", _fmt("#e65100")),
+        (r"\bm\b\s*(?:>|==)\s*0|\bm\b", _fmt("#6a1b9a", italic=True)),
+        (r"->|→|:", _fmt("#455a64", bold=True)),
+        (r"\[|\]", _fmt("#ad1457", bold=True)),
+    )
+    STRING = (r'"[^"]*"?', _fmt("#00695c"))
+    COMMENT = (r"#.*$", _fmt("#757575", italic=True))
+
+    def __init__(self, document) -> None:
+        super().__init__(document)
+        self._rules = [(QRegularExpression(p), f) for p, f in self.RULES]
+        self._string = QRegularExpression(self.STRING[0])
+        self._comment = QRegularExpression(self.COMMENT[0])
+
+    def highlightBlock(self, text: str) -> None:
+        """Apply the formats to one line (strings and comments win over the rest)."""
+        for rx, fmt in self._rules:
+            it = rx.globalMatch(text)
+            while it.hasNext():
+                m = it.next()
+                self.setFormat(m.capturedStart(), m.capturedLength(), fmt)
+        for rx, fmt in ((self._string, self.STRING[1]), (self._comment, self.COMMENT[1])):
+            it = rx.globalMatch(text)
+            while it.hasNext():
+                m = it.next()
+                self.setFormat(m.capturedStart(), m.capturedLength(), fmt)
+
+
+class _LineNumbers(QWidget):
+    """The gutter of a :class:`RulesEditor`."""
+
+    def __init__(self, editor: RulesEditor) -> None:
+        super().__init__(editor)
+        self.editor = editor
+
+    def sizeHint(self) -> QSize:
+        """Return the gutter width for the current line count."""
+        return QSize(self.editor.gutter_width(), 0)
+
+    def paintEvent(self, event) -> None:
+        """Paint the line numbers (and the error marker)."""
+        self.editor.paint_gutter(event)
+
+
+class RulesEditor(QPlainTextEdit):
+    """A plain-text editor with line numbers, an error underline and rule highlighting.
+
+    Signals
+    -------
+    undoRequested(), redoRequested()
+        The user pressed the undo/redo keys (the document's stack handles them).
+    """
+
+    undoRequested = Signal()
+    redoRequested = Signal()
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setUndoRedoEnabled(False)
+        self.setLineWrapMode(QPlainTextEdit.LineWrapMode.NoWrap)
+        font = QFontDatabase.systemFont(QFontDatabase.SystemFont.FixedFont)
+        self.setFont(font)
+        self.setTabStopDistance(4 * self.fontMetrics().horizontalAdvance(" "))
+        self.highlighter = LsysHighlighter(self.document())
+        self._gutter = _LineNumbers(self)
+        self._error: tuple[int, int, str] | None = None
+        self._rule_lines: list[int] = []
+        self.blockCountChanged.connect(self._update_gutter_width)
+        self.updateRequest.connect(self._update_gutter)
+        self._update_gutter_width()
+
+    # -- gutter ---------------------------------------------------------------------------------
+    def gutter_width(self) -> int:
+        """Return the width of the line-number gutter in pixels."""
+        digits = len(str(max(1, self.blockCount())))
+        return 12 + self.fontMetrics().horizontalAdvance("9") * max(2, digits)
+
+    def _update_gutter_width(self, _count: int = 0) -> None:
+        self.setViewportMargins(self.gutter_width(), 0, 0, 0)
+
+    def _update_gutter(self, rect: QRect, dy: int) -> None:
+        if dy:
+            self._gutter.scroll(0, dy)
+        else:
+            self._gutter.update(0, rect.y(), self._gutter.width(), rect.height())
+
+    def resizeEvent(self, event) -> None:
+        """Keep the gutter beside the text."""
+        super().resizeEvent(event)
+        cr = self.contentsRect()
+        self._gutter.setGeometry(QRect(cr.left(), cr.top(), self.gutter_width(), cr.height()))
+
+    def paint_gutter(self, event) -> None:
+        """Paint line numbers; the error line gets a red number on a tinted background."""
+        painter = QPainter(self._gutter)
+        painter.fillRect(event.rect(), self.palette().alternateBase())
+        block = self.firstVisibleBlock()
+        number = block.blockNumber()
+        top = round(self.blockBoundingGeometry(block).translated(self.contentOffset()).top())
+        bottom = top + round(self.blockBoundingRect(block).height())
+        width = self._gutter.width() - 4
+        height = self.fontMetrics().height()
+        while block.isValid() and top <= event.rect().bottom():
+            if block.isVisible() and bottom >= event.rect().top():
+                is_error = self._error is not None and self._error[0] == number + 1
+                if is_error:
+                    painter.fillRect(0, top, self._gutter.width(), height, QColor("#ffcdd2"))
+                    painter.setPen(QColor("#c62828"))
+                else:
+                    painter.setPen(self.palette().placeholderText().color())
+                painter.drawText(0, top, width, height, Qt.AlignmentFlag.AlignRight, str(number + 1))
+            block = block.next()
+            top = bottom
+            bottom = top + round(self.blockBoundingRect(block).height())
+            number += 1
+        painter.end()
+
+    # -- markers --------------------------------------------------------------------------------
+    def set_error(self, line: int | None, column: int | None = None, message: str = "") -> None:
+        """Mark a parse error at 1-based ``line``/``column`` (None clears the marker)."""
+        self._error = None if line is None else (int(line), int(column or 1), message)
+        self.setToolTip(message if line is not None else "")
+        self._refresh_selections()
+        self._gutter.update()
+
+    def set_rule_lines(self, lines: list[int]) -> None:
+        """Highlight whole lines (0-based), e.g. the productions of a clicked element's rule."""
+        self._rule_lines = list(lines)
+        self._refresh_selections()
+        if lines:
+            block = self.document().findBlockByNumber(lines[0])
+            if block.isValid():
+                cursor = QTextCursor(block)
+                self.setTextCursor(cursor)
+                self.ensureCursorVisible()
+
+    def _refresh_selections(self) -> None:
+        selections = []
+        for line in self._rule_lines:
+            block = self.document().findBlockByNumber(line)
+            if not block.isValid():
+                continue
+            sel = QTextEdit.ExtraSelection()
+            sel.format.setBackground(QColor("#fff59d"))
+            sel.format.setProperty(QTextFormat.Property.FullWidthSelection, True)
+            sel.cursor = QTextCursor(block)
+            selections.append(sel)
+        if self._error is not None:
+            line, column, _ = self._error
+            block = self.document().findBlockByNumber(line - 1)
+            if not block.isValid():
+                block = self.document().lastBlock()
+            cursor = QTextCursor(block)
+            start = min(max(column - 1, 0), max(block.length() - 1, 0))
+            cursor.setPosition(block.position() + start)
+            token_end = re.match(r"\S*", block.text()[start:])
+            length = max(1, len(token_end.group(0)) if token_end else 1)
+            if start >= block.length() - 1:  # error at the end of the line: mark the last character
+                cursor.setPosition(block.position() + max(start - 1, 0))
+                length = 1
+            cursor.setPosition(cursor.position() + length, QTextCursor.MoveMode.KeepAnchor)
+            sel = QTextEdit.ExtraSelection()
+            sel.format.setUnderlineStyle(QTextCharFormat.UnderlineStyle.WaveUnderline)
+            sel.format.setUnderlineColor(QColor("#d32f2f"))
+            sel.format.setToolTip(self._error[2])
+            sel.cursor = cursor
+            selections.append(sel)
+        self.setExtraSelections(selections)
+
+    # -- text and keys -----------------------------------------------------------------------------
+    def replace_text(self, text: str) -> None:
+        """Show ``text``, keeping the cursor position and scroll offset where possible."""
+        if text == self.toPlainText():
+            return
+        pos = self.textCursor().position()
+        scroll = self.verticalScrollBar().value()
+        self.setPlainText(text)
+        cursor = self.textCursor()
+        cursor.setPosition(min(pos, len(text)))
+        self.setTextCursor(cursor)
+        self.verticalScrollBar().setValue(scroll)
+        self._refresh_selections()
+
+    def event(self, event) -> bool:
+        """Leave undo/redo shortcuts to the window (the document's undo stack)."""
+        if event.type() == event.Type.ShortcutOverride and (
+            event.matches(QKeySequence.StandardKey.Undo) or event.matches(QKeySequence.StandardKey.Redo)
+        ):
+            event.accept()
+            return True
+        return super().event(event)
+
+    def keyPressEvent(self, event) -> None:
+        """Route undo/redo keys to the document; everything else edits the text."""
+        if event.matches(QKeySequence.StandardKey.Undo):
+            self.undoRequested.emit()
+        elif event.matches(QKeySequence.StandardKey.Redo):
+            self.redoRequested.emit()
+        else:
+            super().keyPressEvent(event)
+
+
+class RulesPanel(QWidget):
+    """The dock content: the rules editor and a line for the current error.
+
+    Signals
+    -------
+    textEdited(text)
+        The user changed the text.
+    """
+
+    textEdited = Signal(str)
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.editor = RulesEditor(self)
+        self.error_label = QLabel(self)
+        self.error_label.setWordWrap(True)
+        self.error_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        self.error_label.setStyleSheet("color: #c62828;")
+        self.error_label.hide()
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(self.editor, 1)
+        layout.addWidget(self.error_label)
+        self._updating = False
+        self._text = ""
+        self.editor.textChanged.connect(self._on_text_changed)
+
+    def text(self) -> str:
+        """Return the text shown."""
+        return self.editor.toPlainText()
+
+    def set_text(self, text: str) -> None:
+        """Show the document's text (does not emit :attr:`textEdited`)."""
+        self._text = text
+        self._updating = True
+        try:
+            self.editor.replace_text(text)
+        finally:
+            self._updating = False
+
+    def set_error(self, error: Any) -> None:
+        """Show a grammar error (with ``line``/``column`` if it has them), or clear it with None."""
+        if error is None:
+            self.editor.set_error(None)
+            self.error_label.hide()
+            return
+        line = getattr(error, "line", None)
+        column = getattr(error, "column", None)
+        message = getattr(error, "message", None) or str(error)
+        self.editor.set_error(line if line is not None else None, column, message)
+        where = f"line {line}, column {column}: " if line is not None else ""
+        self.error_label.setText(where + message)
+        self.error_label.show()
+
+    def highlight_rule(self, name: str | None) -> None:
+        """Highlight the lines defining rule ``name`` (``"axiom"`` for the axiom; None clears)."""
+        if not name:
+            self.editor.set_rule_lines([])
+            return
+        pattern = re.compile(r"^\s*axiom\b" if name == "axiom" else rf"^\s*{re.escape(name)}\s*(?:\(|:|->|→)")
+        lines = [i for i, line in enumerate(self.text().splitlines()) if pattern.match(line)]
+        self.editor.set_rule_lines(lines)
+
+    def _on_text_changed(self) -> None:
+        if self._updating:
+            return
+        text = self.editor.toPlainText()
+        if text != self._text:
+            self._text = text
+            self.textEdited.emit(text)

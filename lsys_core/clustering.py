@@ -1,0 +1,94 @@
+"""Mean-shift clustering with a flat kernel, vectorised with a KD-tree.
+
+scikit-learn's ``MeanShift`` needs tens of seconds for 10⁴ points; here the points are
+first binned into cells of half a bandwidth (bin seeding: one seed per occupied cell,
+weighted by its count), the seeds climb to their modes with ball queries on the
+*weighted cell centroids* (few, so each iteration is cheap), modes closer than half a
+bandwidth are merged, and every point is labelled with its nearest mode.  Coordinates
+are expected pre-scaled so that the bandwidth is 1 in every dimension.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+__all__ = ["mean_shift"]
+
+
+def mean_shift(points: np.ndarray, *, max_iter: int = 30, min_count: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """Cluster ``points`` (already scaled to bandwidth 1) by mean shift.
+
+    Parameters
+    ----------
+    points : ndarray, shape (n, k)
+        Points in a space whose per-dimension bandwidths are 1.
+    max_iter : int
+        Iterations of the mode seeking.
+    min_count : int
+        Modes supported by fewer points are dropped (their points get label -1).
+
+    Returns
+    -------
+    labels : ndarray of int, shape (n,)
+        Cluster index of each point (-1: none), clusters sorted by decreasing size.
+    modes : ndarray, shape (c, k)
+        The cluster modes.
+    """
+    pts = np.asarray(points, dtype=float)
+    n = pts.shape[0]
+    if n == 0:
+        return np.zeros(0, int), np.zeros((0, pts.shape[1] if pts.ndim == 2 else 0))
+    if n == 1:
+        return np.zeros(1, int), pts.copy()
+    # Bin seeding on half-bandwidth cells: weighted centroids of occupied cells.
+    cells = np.floor(pts * 2.0).astype(np.int64)
+    _, inv, counts = np.unique(cells, axis=0, return_inverse=True, return_counts=True)
+    inv = inv.ravel()
+    cent = np.zeros((counts.size, pts.shape[1]))
+    np.add.at(cent, inv, pts)
+    cent /= counts[:, None]
+    w = counts.astype(float)
+    tree = cKDTree(cent)
+    seeds = cent.copy()
+    for _ in range(max_iter):
+        nbrs = tree.query_ball_point(seeds, r=1.0)
+        lens = np.fromiter((len(x) for x in nbrs), int, len(nbrs))
+        flat = np.fromiter((j for x in nbrs for j in x), int, int(lens.sum()))
+        owner = np.repeat(np.arange(len(nbrs)), lens)
+        ws = w[flat]
+        num = np.zeros_like(seeds)
+        np.add.at(num, owner, cent[flat] * ws[:, None])
+        den = np.bincount(owner, weights=ws, minlength=len(nbrs))
+        new = num / np.maximum(den, 1e-300)[:, None]
+        shift = np.abs(new - seeds).max() if new.size else 0.0
+        seeds = new
+        if shift < 1e-4:
+            break
+    # Support of every converged seed, then merge modes closer than half a bandwidth (strongest first).
+    support = np.array([w[x].sum() for x in tree.query_ball_point(seeds, r=1.0)])
+    order = np.argsort(-support, kind="stable")
+    modes: list[np.ndarray] = []
+    for i in order:
+        if support[i] < min_count:
+            continue
+        if modes and np.min(np.linalg.norm(np.asarray(modes) - seeds[i], axis=1)) < 0.5:
+            continue
+        modes.append(seeds[i])
+    if not modes:
+        return np.full(n, -1), np.zeros((0, pts.shape[1]))
+    mode_arr = np.asarray(modes)
+    dist, lab = cKDTree(mode_arr).query(pts, k=1)
+    lab = np.where(dist <= 1.0, lab, -1)
+    # Points farther than a bandwidth from every mode form their own singleton clusters.
+    lone = np.flatnonzero(lab < 0)
+    if lone.size:
+        lab[lone] = mode_arr.shape[0] + np.arange(lone.size)
+        mode_arr = np.vstack([mode_arr, pts[lone]])
+    # Sort clusters by size (largest first).
+    sizes = np.bincount(lab, minlength=mode_arr.shape[0])
+    rank = np.argsort(-sizes, kind="stable")
+    remap = np.empty_like(rank)
+    remap[rank] = np.arange(rank.size)
+    keep = sizes[rank] > 0
+    return remap[lab], mode_arr[rank][keep]

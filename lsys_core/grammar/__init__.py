@@ -1,0 +1,48 @@
+"""The parametric L-system: model, ``.lsys`` text, validation and named parameters.
+
+>>> from lsys_core.grammar import parse_grammar, list_params, set_param   # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+from .model import (
+    COND_EQ0,
+    COND_GT0,
+    Case,
+    Count,
+    Grammar,
+    Linear,
+    Module,
+    Pop,
+    Push,
+    Rule,
+    Symbol,
+    Terminal,
+    Turtle,
+)
+from .params import Param, list_params, set_param, set_params
+from .text import format_grammar, parse_grammar
+from .validate import validate
+
+__all__ = [
+    "COND_EQ0",
+    "COND_GT0",
+    "Case",
+    "Count",
+    "Grammar",
+    "Linear",
+    "Module",
+    "Param",
+    "Pop",
+    "Push",
+    "Rule",
+    "Symbol",
+    "Terminal",
+    "Turtle",
+    "format_grammar",
+    "list_params",
+    "parse_grammar",
+    "set_param",
+    "set_params",
+    "validate",
+]

@@ -1,0 +1,176 @@
+"""The parametric context-free L-system of the paper (§3, §5.1–§5.2), as immutable values.
+
+Modules
+-------
+``f(Δ)``, ``+(δ)``, ``-(δ)``, ``*(s)``
+    :class:`Turtle` commands; their value is linear in the rule's counter ``m``:
+    ``t(m) = t0 + tΔ·m`` (:class:`Linear`).
+``[`` ``]``
+    :class:`Push` / :class:`Pop` of the turtle state.
+``A``, ``P(m-1)``, ``Q(3)``
+    :class:`Symbol`: a terminal (draws its element at the turtle's pose) or a
+    non-terminal, which may take an integer counter argument ``k0 + k1·m``
+    (:class:`Count`).
+
+A :class:`Rule` rewrites one non-terminal; it has one or more :class:`Case` s with a
+condition ``m > 0``, ``m == 0`` or none.  A :class:`Grammar` holds terminals (their SVG
+path data and style, in their own local frame), rules and the axiom.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+__all__ = [
+    "COND_EQ0",
+    "COND_GT0",
+    "Case",
+    "Count",
+    "Grammar",
+    "Linear",
+    "Module",
+    "Pop",
+    "Push",
+    "Rule",
+    "Symbol",
+    "Terminal",
+    "Turtle",
+]
+
+COND_GT0 = "m > 0"
+COND_EQ0 = "m == 0"
+Condition = Literal["m > 0", "m == 0"] | None
+TurtleOp = Literal["f", "+", "-", "*"]
+
+
+@dataclass(frozen=True)
+class Linear:
+    """A value linear in the counter: ``c0 + cd * m``."""
+
+    c0: float
+    cd: float = 0.0
+
+    def at(self, m):
+        """Evaluate at counter ``m`` (scalar or numpy array)."""
+        return self.c0 + self.cd * m if self.cd else self.c0 + 0 * m
+
+
+@dataclass(frozen=True)
+class Count:
+    """An integer counter argument ``k0 + k1 * m`` (``m - 1`` is ``Count(-1, 1)``)."""
+
+    k0: int
+    k1: int = 0
+
+    def at(self, m):
+        """Evaluate at counter ``m`` (scalar or numpy array)."""
+        return self.k0 + self.k1 * m
+
+
+@dataclass(frozen=True)
+class Turtle:
+    """A turtle command ``f``, ``+``, ``-`` or ``*`` with a value linear in ``m``."""
+
+    op: TurtleOp
+    value: Linear
+
+
+@dataclass(frozen=True)
+class Push:
+    """``[``: push the turtle state."""
+
+
+@dataclass(frozen=True)
+class Pop:
+    """``]``: pop the turtle state."""
+
+
+@dataclass(frozen=True)
+class Symbol:
+    """A terminal or non-terminal symbol; ``arg`` is the counter passed to a parametric one."""
+
+    name: str
+    arg: Count | None = None
+
+
+Module = Turtle | Push | Pop | Symbol
+
+
+@dataclass(frozen=True)
+class Case:
+    """One production of a rule: ``cond`` (``"m > 0"``, ``"m == 0"`` or ``None``) and its body."""
+
+    cond: Condition
+    body: tuple[Module, ...]
+
+
+@dataclass(frozen=True)
+class Rule:
+    """The productions of one non-terminal; ``parametric`` rules take a counter ``m``."""
+
+    name: str
+    parametric: bool
+    cases: tuple[Case, ...]
+
+    def case_for(self, m: int) -> Case | None:
+        """Return the first case whose condition holds for counter ``m`` (None: no rewrite).
+
+        A parametric symbol with a negative counter is never rewritten (it draws nothing),
+        so a case without a condition applies for ``m >= 0``.
+        """
+        if self.parametric and m < 0:
+            return None
+        for c in self.cases:
+            if c.cond is None or (c.cond == COND_GT0 and m > 0) or (c.cond == COND_EQ0 and m == 0):
+                return c
+        return None
+
+
+@dataclass(frozen=True)
+class Terminal:
+    """A terminal symbol: an element's SVG path data and CSS style in its local frame.
+
+    ``mirror_of`` names the terminal this one is a mirror image of (informative: the
+    path data already is the mirrored shape).
+    """
+
+    name: str
+    path: str
+    style: str = ""
+    mirror_of: str | None = None
+
+
+@dataclass(frozen=True)
+class Grammar:
+    """A complete L-system: terminals, rules, axiom and the SVG canvas it draws on.
+
+    ``viewbox`` is ``(x, y, width, height)`` of the SVG the grammar came from (None: fit);
+    ``size`` the SVG's ``width`` and ``height`` attributes as written (or None).
+    """
+
+    terminals: tuple[Terminal, ...]
+    rules: tuple[Rule, ...]
+    axiom: tuple[Module, ...]
+    viewbox: tuple[float, float, float, float] | None = None
+    size: tuple[str, str] | None = None
+    comments: tuple[str, ...] = field(default=(), compare=False)
+
+    def terminal(self, name: str) -> Terminal | None:
+        """Return the terminal called ``name``, or None."""
+        for t in self.terminals:
+            if t.name == name:
+                return t
+        return None
+
+    def rule(self, name: str) -> Rule | None:
+        """Return the rule of non-terminal ``name``, or None."""
+        for r in self.rules:
+            if r.name == name:
+                return r
+        return None
+
+    @property
+    def production_count(self) -> int:
+        """Number of productions, the ``m > 0`` and ``m == 0`` cases counted separately."""
+        return sum(len(r.cases) for r in self.rules)

@@ -1,0 +1,368 @@
+"""Check a :class:`~lsys_core.grammar.model.Grammar` for the errors a user can make.
+
+The checks work on the model alone (no text positions), so grammars built by code
+(inference, the editor's sliders) are checked the same way as parsed ones.
+:func:`find_problems` returns every problem with a locator (which rule or the axiom,
+which case, which module); the text parser maps locators to ``line:column``.
+:func:`validate` raises the first problem as a :class:`~lsys_core.errors.GrammarError`.
+
+Termination
+-----------
+Non-terminals form a call graph (an edge for every symbol a rule's body calls).  A
+derivation can only run forever along a cycle of that graph, i.e. inside one strongly
+connected component (SCC).  Inside an SCC every call must be to a parametric symbol
+with an argument ``m - c`` (``Count(-c, 1)``, ``c >= 0``), and no cycle may consist of
+``c == 0`` calls only, so the counter strictly decreases around every cycle.  Calls
+leaving the SCC are unrestricted.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from ..errors import GrammarError
+from .model import COND_EQ0, COND_GT0, Count, Grammar, Linear, Module, Pop, Push, Rule, Symbol, Turtle
+
+__all__ = [
+    "COUNT_LIMIT",
+    "KEYWORDS",
+    "NAME_RE",
+    "RESERVED",
+    "Problem",
+    "count_text",
+    "find_problems",
+    "validate",
+]
+
+NAME_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+"""Pattern of a symbol name."""
+
+KEYWORDS = frozenset({"lsys", "canvas", "viewbox", "size", "terminal", "style", "mirror", "axiom"})
+"""Words of the text format that cannot name a symbol."""
+
+RESERVED = KEYWORDS | {"f", "m", "eps", "nan", "inf", "infinity"}
+"""Every word that cannot name a symbol (keywords, the ``f`` module, the counter, ε, non-finite numbers)."""
+
+COUNT_LIMIT = 2**31 - 1
+"""Largest magnitude of a counter coefficient."""
+
+Where = Literal["grammar", "canvas", "terminal", "axiom", "rule"]
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One problem of a grammar, with a locator.
+
+    Attributes
+    ----------
+    message : str
+        What is wrong, one line, without the location.
+    where : str
+        ``"rule"`` (``owner`` is the rule name), ``"axiom"``, ``"terminal"`` (``owner`` is
+        the terminal name), ``"canvas"`` or ``"grammar"`` (the whole grammar).
+    owner : str
+        Rule or terminal name, ``"axiom"`` for the axiom, ``"viewbox"`` or ``"size"`` for
+        the canvas, ``""`` for the whole grammar.
+    case : int or None
+        0-based case index within the rule (0 for the axiom).
+    index : int or None
+        0-based module index within the body; None for the rule or case as a whole.
+    arg : bool
+        True when the problem is the module's argument rather than the module itself.
+    """
+
+    message: str
+    where: Where
+    owner: str = ""
+    case: int | None = None
+    index: int | None = None
+    arg: bool = False
+
+    def describe(self) -> str:
+        """Return the message with the locator in words, for grammars without text positions."""
+        if self.where == "rule":
+            place = f"rule {self.owner}"
+            if self.case is not None:
+                place += f", case {self.case + 1}"
+        elif self.where == "terminal":
+            place = f"terminal {self.owner}"
+        else:
+            place = self.where
+        if self.index is not None:
+            place += f", module {self.index + 1}"
+        return f"{self.message} (in {place})"
+
+
+def validate(g: Grammar) -> None:
+    """Raise :class:`~lsys_core.errors.GrammarError` for the first problem of ``g``.
+
+    Parameters
+    ----------
+    g : Grammar
+        The grammar to check.
+
+    Raises
+    ------
+    GrammarError
+        Naming the problem and where it is (rule, case and module).
+    """
+    problems = find_problems(g)
+    if problems:
+        more = f" (and {len(problems) - 1} more problems)" if len(problems) > 1 else ""
+        raise GrammarError(problems[0].describe() + more)
+
+
+def find_problems(g: Grammar) -> list[Problem]:
+    """Return every problem of ``g``: names, canvas, conditions, bodies, axiom, termination.
+
+    Parameters
+    ----------
+    g : Grammar
+        The grammar to check.
+
+    Returns
+    -------
+    list of Problem
+        Empty when the grammar is valid.
+    """
+    problems = list(_name_problems(g))
+    problems += _canvas_problems(g)
+    names = _Names({t.name for t in g.terminals}, {r.name: r.parametric for r in g.rules})
+    for r in g.rules:
+        problems += _case_problems(r)
+        for ci, case in enumerate(r.cases):
+            problems += _body_problems(names, case.body, "rule", r.name, ci, r.parametric)
+    if not g.axiom:
+        problems.append(Problem("missing axiom: add a line 'axiom: ...'", "grammar"))
+    problems += _body_problems(names, g.axiom, "axiom", "axiom", 0, False)
+    if not problems:  # the call graph is only meaningful for a well-formed grammar
+        problems += _termination_problems(g)
+    return problems
+
+
+@dataclass(frozen=True)
+class _Names:
+    """The declared symbols: terminal names, and whether each rule is parametric."""
+
+    terminals: set[str]
+    parametric: dict[str, bool]
+
+
+def _name_problems(g: Grammar) -> Iterator[Problem]:
+    """Yield problems with terminal and rule names."""
+    seen: set[str] = set()
+    for t in g.terminals:
+        if bad := _bad_name(t.name):
+            yield Problem(bad, "terminal", t.name)
+        if t.name in seen:
+            yield Problem(f"duplicate terminal '{t.name}'", "terminal", t.name)
+        seen.add(t.name)
+        if not isinstance(t.path, str) or not isinstance(t.style, str):
+            yield Problem(f"terminal '{t.name}' needs string path data and style", "terminal", t.name)
+    for t in g.terminals:
+        if t.mirror_of is not None and t.mirror_of not in seen:
+            yield Problem(f"'mirror {t.mirror_of}' does not name a terminal", "terminal", t.name, arg=True)
+    rule_names: set[str] = set()
+    for r in g.rules:
+        if bad := _bad_name(r.name):
+            yield Problem(bad, "rule", r.name, 0)
+        if r.name in seen:
+            yield Problem(f"'{r.name}' is a terminal and cannot have a rule", "rule", r.name, 0)
+        if r.name in rule_names:
+            yield Problem(f"rule '{r.name}' is defined twice", "rule", r.name, 0)
+        rule_names.add(r.name)
+
+
+def _bad_name(name: object) -> str | None:
+    """Return why ``name`` cannot name a symbol, or None."""
+    if not isinstance(name, str) or not NAME_RE.fullmatch(name):
+        return f"invalid symbol name {name!r}"
+    if name in RESERVED:
+        return f"'{name}' is reserved and cannot name a symbol"
+    return None
+
+
+def _canvas_problems(g: Grammar) -> list[Problem]:
+    """Return problems with the viewBox and size."""
+    out = []
+    if g.viewbox is not None:
+        vb = g.viewbox
+        if len(vb) != 4 or not all(_finite(v) for v in vb):
+            out.append(Problem("viewbox needs 4 finite numbers", "canvas", "viewbox"))
+        elif vb[2] <= 0 or vb[3] <= 0:
+            out.append(Problem("viewbox width and height must be positive", "canvas", "viewbox"))
+    if g.size is not None and (len(g.size) != 2 or not all(isinstance(s, str) for s in g.size)):
+        out.append(Problem("size needs two strings (width and height)", "canvas", "size"))
+    return out
+
+
+def _case_problems(r: Rule) -> list[Problem]:
+    """Return problems with a rule's conditions: wrong kind, or a case no counter can reach."""
+    out = []
+    if not r.cases:
+        out.append(Problem(f"rule {r.name} has no productions", "rule", r.name, 0))
+    covered: set[str | None] = set()
+    for ci, case in enumerate(r.cases):
+        msg = None
+        if case.cond is not None and not r.parametric:
+            msg = f"rule {r.name} has no counter m, so it cannot have a condition"
+        elif case.cond not in (None, COND_GT0, COND_EQ0):
+            msg = f"unknown condition {case.cond!r}: use 'm > 0' or 'm == 0'"
+        elif (
+            None in covered or case.cond in covered or (case.cond is None and {COND_GT0, COND_EQ0} <= covered)
+        ):
+            msg = f"rule {r.name}: this case is never used (an earlier case covers it)"
+        if msg:
+            out.append(Problem(msg, "rule", r.name, ci))
+        covered.add(case.cond)
+    return out
+
+
+def _body_problems(
+    names: _Names, body: tuple[Module, ...], where: Where, owner: str, ci: int, parametric: bool
+) -> list[Problem]:
+    """Return problems with the modules of one body (values, symbols, arity, brackets)."""
+    out: list[Problem] = []
+
+    def add(msg: str, i: int, arg: bool = False) -> None:
+        out.append(Problem(msg, where, owner, ci, i, arg))
+
+    no_m = "m cannot be used in the axiom" if where == "axiom" else f"m cannot be used in rule {owner}"
+    if where == "rule" and not parametric:
+        no_m += f", which has no counter (declare {owner}(m))"
+    opens: list[int] = []
+    for i, mod in enumerate(body):
+        if isinstance(mod, Push):
+            opens.append(i)
+        elif isinstance(mod, Pop):
+            if not opens:
+                add("unbalanced ']': no '[' to close", i)
+            else:
+                opens.pop()
+        elif isinstance(mod, Turtle):
+            if msg := _turtle_problem(mod, parametric, no_m):
+                add(msg, i, arg=True)
+        elif isinstance(mod, Symbol):
+            if found := _symbol_problem(names, mod, parametric, no_m):
+                add(found[0], i, found[1])
+        else:
+            add(f"unknown module {mod!r}", i)
+    for i in opens:
+        add("unbalanced '[': no ']' closes it", i)
+    return out
+
+
+def _turtle_problem(mod: Turtle, parametric: bool, no_m: str) -> str | None:
+    """Return what is wrong with a turtle module, or None."""
+    if mod.op not in ("f", "+", "-", "*"):
+        return f"unknown turtle command {mod.op!r}"
+    v = mod.value
+    if not isinstance(v, Linear) or not (_finite(v.c0) and _finite(v.cd)):
+        return f"the value of {mod.op}(...) must be a finite number"
+    if v.cd != 0 and not parametric:
+        return no_m
+    if mod.op == "*" and v.cd == 0 and v.c0 <= 0:
+        return "scale must be positive: *(0) or a negative *(s) collapses or flips the drawing"
+    return None
+
+
+def _symbol_problem(names: _Names, mod: Symbol, parametric: bool, no_m: str) -> tuple[str, bool] | None:
+    """Return what is wrong with a symbol module and whether it is the argument, or None."""
+    name = mod.name
+    if name in names.terminals:
+        return (f"terminal {name} takes no argument", False) if mod.arg is not None else None
+    parametric_rule = names.parametric.get(name)
+    if parametric_rule is None:
+        return f"undefined symbol '{name}': declare it as a terminal or give it a rule", False
+    if parametric_rule and mod.arg is None:
+        return f"{name} takes a counter argument, e.g. {name}(3) or {name}(m-1)", False
+    if not parametric_rule and mod.arg is not None:
+        return f"{name} takes no counter: write {name}, or declare its rule as {name}(m)", False
+    if mod.arg is None:
+        return None
+    a = mod.arg
+    if not isinstance(a, Count) or not all(_is_int(k) for k in (a.k0, a.k1)):
+        return f"counter argument of {name} must be integer", True
+    if abs(a.k0) > COUNT_LIMIT or abs(a.k1) > COUNT_LIMIT:
+        return f"counter argument of {name} is out of range (|k| <= {COUNT_LIMIT})", True
+    if a.k1 != 0 and not parametric:
+        return no_m, True
+    return None
+
+
+def _termination_problems(g: Grammar) -> list[Problem]:
+    """Return a problem for every call that lets a derivation loop forever."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    index = {r.name: i for i, r in enumerate(g.rules)}
+    calls = [
+        (index[r.name], index[mod.name], r, ci, mi, mod)
+        for r in g.rules
+        for ci, case in enumerate(r.cases)
+        for mi, mod in enumerate(case.body)
+        if isinstance(mod, Symbol) and mod.name in index
+    ]
+    if not calls:
+        return []
+
+    def scc(edges: list[tuple[int, int]]) -> np.ndarray:
+        src, dst = np.array(edges, dtype=int).T
+        mat = coo_matrix((np.ones(len(edges)), (src, dst)), shape=(len(index), len(index)))
+        return connected_components(mat, directed=True, connection="strong")[1]
+
+    def cyclic(labels: np.ndarray, edges: list[tuple[int, int]]) -> list[bool]:
+        """Tell for each edge whether it lies on a cycle (same SCC, or a self-loop)."""
+        sizes = np.bincount(labels, minlength=len(index))
+        return [labels[u] == labels[v] and (u == v or sizes[labels[u]] > 1) for u, v in edges]
+
+    edges = [(u, v) for u, v, *_ in calls]
+    out = []
+    zero_calls = []
+    for on_cycle, c in zip(cyclic(scc(edges), edges), calls, strict=True):
+        _, v, r, ci, mi, mod = c
+        if not on_cycle:
+            continue
+        call = mod.name + (f"({count_text(mod.arg)})" if mod.arg is not None else "")
+        if not g.rules[v].parametric:
+            why = f"the call {call} closes a cycle that has no counter to stop it"
+        elif mod.arg.k1 != 1 or mod.arg.k0 > 0:
+            why = f"the call {call} does not decrease m (write {mod.name}(m-1))"
+        else:
+            if mod.arg.k0 == 0:
+                zero_calls.append(c)
+            continue
+        out.append(Problem(f"rule {r.name} never terminates: {why}", "rule", r.name, ci, mi))
+    if zero_calls:  # m - 0 is fine only if every cycle through it also has a decreasing call
+        zedges = [(u, v) for u, v, *_ in zero_calls]
+        for on_cycle, (_, _, r, ci, mi, mod) in zip(cyclic(scc(zedges), zedges), zero_calls, strict=True):
+            if on_cycle:
+                why = f"the call {mod.name}(m) does not decrease m (write {mod.name}(m-1))"
+                out.append(Problem(f"rule {r.name} never terminates: {why}", "rule", r.name, ci, mi))
+    return out
+
+
+def count_text(a: Count) -> str:
+    """Return a counter argument as ``.lsys`` text: ``3``, ``m``, ``m-1``, ``2*m+1``, ``-m``."""
+    k0, k1 = int(a.k0), int(a.k1)
+    if k1 == 0:
+        return str(k0)
+    head = "m" if k1 == 1 else "-m" if k1 == -1 else f"{k1}*m"
+    return head if k0 == 0 else f"{head}{k0:+d}"
+
+
+def _finite(x: object) -> bool:
+    """Tell whether ``x`` is a finite real number."""
+    real = isinstance(x, int | float | np.integer | np.floating) and not isinstance(x, bool)
+    return real and math.isfinite(x)
+
+
+def _is_int(x: object) -> bool:
+    """Tell whether ``x`` is an integer (Python or numpy), not a bool."""
+    return isinstance(x, int | np.integer) and not isinstance(x, bool)

@@ -1,0 +1,167 @@
+"""The whole inference, from a :class:`~lsys_core.model.Scene` to a :class:`Grammar`.
+
+>>> from lsys_core.svg.parse import load_svg              # doctest: +SKIP
+>>> result = infer(load_svg("helix.svg"))                 # doctest: +SKIP
+>>> print(format_grammar(result.grammar))                  # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from .cancel import CancelToken, Progress, check, report
+from .errors import InferenceError
+from .grammar.model import Grammar
+from .inference import Tolerance, Weights, build_hierarchy
+from .model import Instancing, Scene
+from .postprocess import simplify
+
+__all__ = ["InferenceResult", "InferenceSettings", "infer", "symmetrize"]
+
+#: Bandwidth factor used by :func:`symmetrize` (the paper's "relaxed sensitivity").
+RELAXED = 12.0
+
+
+@dataclass(frozen=True)
+class InferenceSettings:
+    """User settings of the inference.
+
+    Attributes
+    ----------
+    wn, wh, wphi, wl : float
+        Cluster importance weights in [0, 1] (§5.4): repetition count, proximity,
+        similarity and sequence length.
+    similarity : float
+        Similarity threshold φ for two elements to share a terminal (§4.1).
+    tolerance : float
+        Factor on the clustering bandwidths; larger values merge jittered repetitions.
+    neighbours : int
+        Neighbours per node in the transformation spaces.
+    """
+
+    wn: float = Weights.wn
+    wh: float = Weights.wh
+    wphi: float = Weights.wphi
+    wl: float = Weights.wl
+    similarity: float = 0.6
+    tolerance: float = 1.0
+    neighbours: int = 12
+
+    def relaxed(self, factor: float = RELAXED) -> InferenceSettings:
+        """Return these settings with the tolerance multiplied by ``factor`` (for symmetrization)."""
+        return replace(self, tolerance=self.tolerance * factor)
+
+    def validated(self) -> InferenceSettings:
+        """Return the settings, raising :class:`InferenceError` for values out of range."""
+        for name in ("wn", "wh", "wphi", "wl"):
+            v = getattr(self, name)
+            if not (0.0 <= v <= 1.0):
+                raise InferenceError(f"weight {name} must be in [0, 1], got {v}")
+        if not (0.0 < self.similarity <= 1.0):
+            raise InferenceError(f"similarity threshold must be in (0, 1], got {self.similarity}")
+        if not (0.0 < self.tolerance <= 1000.0) or not np.isfinite(self.tolerance):
+            raise InferenceError(f"tolerance must be in (0, 1000], got {self.tolerance}")
+        return self
+
+
+@dataclass(frozen=True, eq=False)
+class InferenceResult:
+    """What :func:`infer` returns: the grammar, the instancing and timings (seconds per stage)."""
+
+    grammar: Grammar
+    instancing: Instancing
+    stages: dict[str, float]
+    seconds: float
+    element_rule: np.ndarray
+    log: tuple[str, ...] = field(default=())
+
+
+def _element_circles(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+    """Return the centre and radius of every element's control polygon (vectorised)."""
+    sizes = np.array([e.cubics.shape[0] for e in scene.elements])
+    pts = np.concatenate([e.cubics.reshape(-1) for e in scene.elements])
+    owner = np.repeat(np.arange(sizes.size), sizes * 4)
+    cnt = np.bincount(owner, minlength=sizes.size)
+    cen = (np.bincount(owner, pts.real, sizes.size) + 1j * np.bincount(owner, pts.imag, sizes.size)) / cnt
+    rad = np.zeros(sizes.size)
+    np.maximum.at(rad, owner, np.abs(pts - cen[owner]))
+    return cen, rad
+
+
+def _shape_similarity(inst: Instancing) -> np.ndarray:
+    """Similarity of pairs of terminals for the importance's φ (mirror images count as alike)."""
+    k = len(inst.terminals)
+    sim = np.full((k, k), 0.5)
+    for g, m in enumerate(inst.mirrored_of):
+        if m >= 0:
+            sim[g, m] = sim[m, g] = 0.9
+    np.fill_diagonal(sim, 1.0)
+    return sim
+
+
+def infer(
+    scene: Scene,
+    settings: InferenceSettings = InferenceSettings(),
+    *,
+    cancel: CancelToken | None = None,
+    progress: Progress | None = None,
+) -> InferenceResult:
+    """Infer a compact L-system that regenerates ``scene`` (paper §4–§5).
+
+    Parameters
+    ----------
+    scene : Scene
+        The imported SVG.
+    settings : InferenceSettings
+        Weights, similarity threshold and clustering tolerance.
+    cancel : CancelToken, optional
+        Checked between stages and levels; raises :class:`~lsys_core.errors.Cancelled`.
+    progress : callable, optional
+        ``progress(stage, fraction)`` for the stages ``similarity`` and ``rules``.
+
+    Returns
+    -------
+    InferenceResult
+    """
+    from .similarity import detect_similarity
+
+    settings = settings.validated()
+    if not scene.elements:
+        raise InferenceError("the scene has no drawable elements")
+    t_all = time.perf_counter()
+    stages: dict[str, float] = {}
+    t = time.perf_counter()
+    inst = detect_similarity(scene, threshold=settings.similarity, cancel=cancel, progress=progress)
+    stages["similarity"] = time.perf_counter() - t
+    check(cancel)
+    center, radius = _element_circles(scene)
+    sizes = np.zeros(len(inst.terminals))
+    np.maximum.at(sizes, inst.group, radius / np.maximum(np.abs(inst.a), 1e-300))
+    weights = Weights(settings.wn, settings.wh, settings.wphi, settings.wl)
+    tol = Tolerance().scaled(settings.tolerance)
+    hier = build_hierarchy(
+        [t.name for t in inst.terminals], sizes, inst.group, inst.a, inst.b, center, radius,
+        weights=weights, tol=tol, similarity=_shape_similarity(inst), neighbours=settings.neighbours,
+        cancel=cancel, progress=progress, timer=stages,
+    )
+    t = time.perf_counter()
+    grammar = Grammar(inst.terminals, tuple(hier.rules), hier.axiom, scene.viewbox, scene.size)
+    grammar = simplify(grammar)
+    stages["postprocess"] = time.perf_counter() - t
+    report(progress, "done", 1.0)
+    return InferenceResult(grammar, inst, stages, time.perf_counter() - t_all, hier.node_rule, tuple(hier.log))
+
+
+def symmetrize(
+    scene: Scene,
+    settings: InferenceSettings = InferenceSettings(),
+    *,
+    factor: float = RELAXED,
+    cancel: CancelToken | None = None,
+    progress: Progress | None = None,
+) -> InferenceResult:
+    """Infer with relaxed clustering so jittered repetitions share one mean transform (Fig. 10)."""
+    return infer(scene, settings.relaxed(factor), cancel=cancel, progress=progress)

@@ -1,0 +1,405 @@
+"""Find similar elements and replace them by terminal symbols with poses (paper §4.1–§4.2).
+
+Two elements are similar when one is the image of the other under a similarity
+(translation, rotation, uniform scale) up to the similarity threshold ``φ``, and they are
+drawn with the same style.  Each group of similar elements becomes one terminal symbol:
+the shape of a representative element in a local frame centred on its centroid, and a
+pose ``z -> a*z + b`` per element.  Mirror images form their own group, linked by
+``mirrored_of`` (the flips of §5.4).
+
+Elements are not compared pairwise: cheap invariant descriptors (sorted radial distances,
+perimeter over radius, style) pick the candidates of each new representative, and the
+candidates are matched against it in vectorised batches (:mod:`.similarity_match`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .cancel import CancelToken, Progress, check, report
+from .errors import InferenceError
+from .grammar.model import Terminal
+from .model import Element, Instancing, Scene
+from .similarity_exact import EXACT_TOL, fit_exact, structure_key, variants
+from .similarity_match import PERFECT, Batch, Reference, match_batch
+from .similarity_sampling import Samples, arc_fractions, element_features, sample_elements
+
+__all__ = ["detect_similarity", "format_cubics", "symmetry_order", "terminal_name"]
+
+#: Samples per element for voting, ICP and φ; the representative gets ``_DENSE`` times more.
+_SAMPLES = 96
+_DENSE = 8
+_CHUNK = 1024
+_STAGE = "similarity"
+
+
+def terminal_name(index: int) -> str:
+    """Return the name of the ``index``-th terminal: ``A`` … ``Z``, then ``A1`` … ``Z1``, ``A2`` …."""
+    letter = chr(ord("A") + index % 26)
+    return letter if index < 26 else f"{letter}{index // 26}"
+
+
+def _num(v: float) -> str:
+    """Format a coordinate compactly (at most 4 decimals, no trailing zeros)."""
+    s = f"{v:.4f}".rstrip("0").rstrip(".")
+    return "0" if s in ("-0", "") else s
+
+
+def _pt(z: complex) -> str:
+    return f"{_num(z.real)},{_num(z.imag)}"
+
+
+def format_cubics(cubics: np.ndarray, subpaths: np.ndarray, closed: tuple[bool, ...]) -> str:
+    """Format cubic segments as SVG path data, writing straight segments as ``L``.
+
+    Parameters
+    ----------
+    cubics : ndarray of complex, shape (k, 4)
+        Control points.
+    subpaths : ndarray of int, shape (k,)
+        Subpath index of every segment.
+    closed : tuple of bool
+        Whether each subpath is closed.
+    """
+    out: list[str] = []
+    prev = None
+    for i, seg in enumerate(np.asarray(cubics, dtype=complex).reshape(-1, 4)):
+        sp = int(subpaths[i])
+        if sp != prev:
+            if prev is not None and prev < len(closed) and closed[prev]:
+                out.append("Z")
+            out.append(f"M{_pt(seg[0])}")
+            prev = sp
+        chord = seg[3] - seg[0]
+        size = max(abs(chord), 1e-12)
+        rel = (seg[1:3] - seg[0]) * np.conj(chord) / size
+        straight = np.all(np.abs(rel.imag) <= 1e-9 * size) and np.all(rel.real >= -1e-9 * size * size)
+        straight = straight and np.all(rel.real <= size * size * (1 + 1e-9))
+        out.append(f"L{_pt(seg[3])}" if straight else f"C{_pt(seg[1])} {_pt(seg[2])} {_pt(seg[3])}")
+    if prev is not None and prev < len(closed) and closed[prev]:
+        out.append("Z")
+    return " ".join(out)
+
+
+def _path_data(element: Element, origin: complex) -> str:
+    """Return the element's path data translated by ``-origin`` (the pathdata module's if present)."""
+    cubics = np.asarray(element.cubics, dtype=complex).reshape(-1, 4) - origin
+    try:
+        from .svg.pathdata import d_from_cubics
+    except ImportError:
+        return format_cubics(cubics, element.subpaths, element.closed)
+    return d_from_cubics(cubics, element.subpaths, element.closed)
+
+
+def _style_key(style: str) -> str:
+    """Return the style's declarations in a canonical order, without the stroke width.
+
+    The stroke width does not split groups: tools scale it with the shape or not, so
+    copies of one shape carry all sorts of widths; the terminal keeps the representative's.
+    """
+    decls: dict[str, str] = {}
+    for part in style.split(";"):
+        key, sep, value = part.partition(":")
+        if sep:
+            decls[key.strip().lower()] = value.strip()
+    decls.pop("stroke-width", None)
+    return ";".join(f"{k}:{v}" for k, v in sorted(decls.items()))
+
+
+def _rotate_residual(dense: np.ndarray, normals: np.ndarray, tree: cKDTree, angle: float) -> float:
+    """Return the largest point-to-line distance of the rotated samples to the unrotated ones."""
+    x = dense * np.exp(1j * angle)
+    dist, nn = tree.query(np.column_stack([x.real, x.imag]))
+    line = np.abs(((x - dense[nn]) * np.conj(normals[nn])).real)
+    return float(max(line.max(), 0.2 * dist.max()))
+
+
+def symmetry_order(dense: np.ndarray, normals: np.ndarray, tol: float = 4e-3) -> tuple[int, int]:
+    """Detect the rotational symmetry of a shape from dense samples about its centroid.
+
+    Parameters
+    ----------
+    dense : ndarray of complex
+        Arc-length uniform samples, centred on their mean and scaled to RMS radius 1.
+    normals : ndarray of complex
+        Unit normals at the samples.
+    tol : float
+        Allowed deviation (in RMS radii) of the rotated shape from itself.
+
+    Returns
+    -------
+    tuple of int
+        ``(order, period)``: ``order`` is 1 (none), ``k`` (k-fold, k ≤ 12) or 0 (continuous,
+        or more than 12-fold); ``period`` is the ``k`` to reduce pose angles by (0: any angle).
+    """
+    tree = cKDTree(np.column_stack([dense.real, dense.imag]))
+    ms = np.arange(2, 65)
+    mag = np.abs(dense)
+    with np.errstate(over="ignore", invalid="ignore"):
+        num = np.abs(np.mean(dense[None, :] ** ms[:, None], axis=1))
+        den = np.mean(mag[None, :] ** ms[:, None], axis=1)
+    strength = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
+    sig = ms[strength > 2e-3 * np.maximum(1.0, ms / 16.0)]
+    if sig.size == 0:
+        if all(_rotate_residual(dense, normals, tree, ang) < tol for ang in (0.7137, 2.0911, 3.3)):
+            return 0, 0
+        return 1, 1
+    g = int(np.gcd.reduce(sig))
+    for k in range(g, 1, -1):
+        if g % k == 0 and _rotate_residual(dense, normals, tree, 2 * np.pi / k) < tol:
+            return (k if k <= 12 else 0), k
+    return 1, 1
+
+
+def _canonical(a: np.ndarray, period: int) -> np.ndarray:
+    """Reduce pose rotations to the equivalent one of smallest angle under k-fold symmetry."""
+    if period == 1:
+        return a
+    if period == 0:
+        return np.abs(a).astype(complex)
+    step = 2 * np.pi / period
+    ang = np.angle(a)
+    red = ang - np.round(ang / step) * step
+    red = np.where(red <= -np.pi / period + 1e-12, red + step, red)
+    return np.abs(a) * np.exp(1j * red)
+
+
+def _sample_all(elements, fractions, cancel) -> Samples:
+    """Sample all elements in chunks, checking the cancel token in between."""
+    parts = []
+    for lo in range(0, len(elements), 4 * _CHUNK):
+        check(cancel)
+        parts.append(sample_elements(elements[lo : lo + 4 * _CHUNK], fractions))
+    return Samples(*(np.concatenate([getattr(p, f) for p in parts]) for f in Samples.__dataclass_fields__))
+
+
+class _Rep:
+    """A representative: its element index, local origin, dense samples and references."""
+
+    def __init__(self, element: Element, index: int, coarse: Samples):
+        dense_frac = ((np.arange(_SAMPLES * _DENSE) + _DENSE / 2) / (_SAMPLES * _DENSE)) % 1.0
+        dense = sample_elements([element], dense_frac)
+        self.index = index
+        self.origin = complex(dense.points[0].mean())
+        rel = dense.points[0] - self.origin
+        self.radius = float(np.sqrt(np.mean(np.abs(rel) ** 2)))
+        inv = 1.0 / self.radius
+        self.dense = rel * inv
+        self.dense_normals = dense.normals[0]
+        self.ref = Reference.build(
+            (coarse.points[index] - self.origin) * inv,
+            coarse.normals[index],
+            coarse.curvature[index] * self.radius,
+            self.dense,
+            self.dense_normals,
+            float(dense.length[0]) * inv,
+        )
+        self.control = np.asarray(element.cubics, dtype=complex).ravel()
+        self.orders = variants(element)
+
+
+class _Matcher:
+    """Per-element data shared by all rounds, and the matching of a chunk against a representative."""
+
+    def __init__(self, elements: tuple[Element, ...], coarse: Samples, centroid, radius):
+        self.elements = elements
+        self.coarse = coarse
+        self.centroid = centroid
+        self.radius = radius
+        keys = [structure_key(e) for e in elements]
+        ids = {k: i for i, k in enumerate(dict.fromkeys(keys))}
+        self.structure = np.array([ids[k] for k in keys])
+
+    def match(self, rep: _Rep, chunk: np.ndarray, threshold: float, mirrored: bool):
+        """Match ``chunk`` against ``rep`` (flipped first if ``mirrored``).
+
+        Exact copies of the representative's control points are recognised in closed form;
+        the others go through voting and ICP.
+
+        Returns
+        -------
+        ok : ndarray of bool
+            Which candidates are similar (``φ >= threshold``).
+        phi, gap : ndarray of float
+            Similarity and fit gap (RMS distance in RMS radii) of each candidate.
+        a, b : ndarray of complex
+            The poses ``element = a * local + b`` (meaningless where not ``ok`` or mirrored).
+        """
+        m = chunk.size
+        phi = np.zeros(m)
+        gap = np.full(m, np.inf)
+        a = np.ones(m, complex)
+        b = np.zeros(m, complex)
+        flip = np.conj if mirrored else (lambda z: z)
+        same = self.structure[chunk] == self.structure[rep.index]
+        if rep.orders is not None and same.any():
+            sel = np.flatnonzero(same)
+            ctrl = np.stack([np.asarray(self.elements[i].cubics, dtype=complex).ravel() for i in chunk[sel]])
+            ea, eb, misfit = fit_exact(rep.control, rep.orders, flip(ctrl))
+            exact = misfit < EXACT_TOL
+            sel = sel[exact]
+            a[sel], b[sel] = ea[exact], eb[exact] + ea[exact] * rep.origin
+            phi[sel], gap[sel] = 1.0, misfit[exact]
+        rest = np.flatnonzero(phi < 1.0)
+        if rest.size:
+            sub = chunk[rest]
+            r = self.radius[sub]
+            batch = Batch(
+                flip((self.coarse.points[sub] - self.centroid[sub, None]) / r[:, None]),
+                flip(self.coarse.normals[sub]),
+                self.coarse.curvature[sub] * r[:, None],
+            )
+            res = match_batch(rep.ref, batch, self.coarse.length[sub] / r)
+            # rep ≈ c * cand + d (normalised)  =>  element = a * local + b
+            a[rest] = r / (rep.radius * res.c)
+            b[rest] = flip(self.centroid[sub]) - a[rest] * rep.radius * res.d
+            phi[rest], gap[rest] = res.phi, res.gap
+        return phi >= threshold, phi, gap, a, b
+
+    def prefer_mirror(self, rep: _Rep, chunk: np.ndarray, threshold: float, ok, phi, gap) -> np.ndarray:
+        """Return which candidates are mirror images of ``rep`` rather than (imperfect) copies.
+
+        A candidate is a mirror image when it matches the flipped representative and that
+        match is clearly better than the direct one, so mirror-symmetric shapes stay copies.
+        """
+        test = np.flatnonzero(~ok | (gap > PERFECT))
+        result = np.zeros(chunk.size, bool)
+        if test.size == 0:
+            return result
+        mok, mphi, mgap, _, _ = self.match(rep, chunk[test], threshold, mirrored=True)
+        better = (mphi > phi[test] + 0.02) | ((mphi >= phi[test]) & (mgap < 0.5 * gap[test]))
+        result[test] = mok & (~ok[test] | better)
+        return result
+
+
+def detect_similarity(
+    scene: Scene,
+    *,
+    threshold: float = 0.6,
+    flips: bool = True,
+    cancel: CancelToken | None = None,
+    progress: Progress | None = None,
+) -> Instancing:
+    """Group similar elements into terminals and recover every element's pose.
+
+    Parameters
+    ----------
+    scene : Scene
+        The imported elements.
+    threshold : float
+        Smallest similarity ``φ`` (share of matching samples, in [0, 1]) for two elements
+        to be grouped (the paper's default is 0.6).
+    flips : bool
+        Detect mirror images as separate, linked groups; when False a mirror image is
+        just another shape.
+    cancel : CancelToken, optional
+        Checked between batches.
+    progress : Progress, optional
+        Called as ``progress("similarity", fraction)``.
+
+    Returns
+    -------
+    Instancing
+        Group, pose ``(a, b)`` of every element, one terminal per group (path data in the
+        representative's frame: origin at its centroid, orientation and size as drawn),
+        rotational symmetry orders and mirror links.
+
+    Raises
+    ------
+    InferenceError
+        If ``threshold`` is outside [0, 1].
+    """
+    if not (0.0 <= threshold <= 1.0) or math.isnan(threshold):
+        raise InferenceError(f"similarity threshold must be between 0 and 1, got {threshold}")
+    elements = tuple(scene.elements)
+    n = len(elements)
+    report(progress, _STAGE, 0.0)
+    if n == 0:
+        empty = np.zeros(0, dtype=int)
+        return Instancing(empty, np.zeros(0, complex), np.zeros(0, complex), (), empty, empty.copy())
+    coarse = _sample_all(elements, arc_fractions(_SAMPLES), cancel)
+    centroid, radius, desc = element_features(coarse)
+    extent = np.abs(coarse.points - centroid[:, None]).max(axis=1)
+    span = np.maximum(np.abs(coarse.points).max(axis=1), 1.0)
+    degenerate = (coarse.length <= 1e-9 * span) | (radius <= 1e-9 * span) | ~np.isfinite(radius)
+    degenerate |= extent <= 1e-9 * span
+    parsed = {st: _style_key(st) for st in {e.style for e in elements}}
+    key_ids = {k: i for i, k in enumerate(dict.fromkeys(parsed[e.style] for e in elements))}
+    key_of = np.array([key_ids[parsed[e.style]] for e in elements])
+    trees = {}
+    for k in range(len(key_ids)):
+        members = np.flatnonzero((key_of == k) & ~degenerate)
+        if members.size:
+            trees[k] = (members, cKDTree(desc[members]))
+    tol = 0.1 + 0.3 * (1.0 - threshold)
+    matcher = _Matcher(elements, coarse, centroid, np.where(degenerate, 1.0, radius))
+    group = np.full(n, -1, dtype=int)
+    a = np.ones(n, complex)
+    b = np.where(degenerate, coarse.points[:, 0], centroid)
+    reps: list[_Rep | None] = []
+    rep_index: list[int] = []
+    mirror_of: list[int] = []
+    pending: deque[tuple[int, int]] = deque()
+    cursor = 0
+    while True:
+        check(cancel)
+        if pending:
+            r, mirror = pending.popleft()
+            if group[r] >= 0:
+                continue
+        else:
+            while cursor < n and group[cursor] >= 0:
+                cursor += 1
+            if cursor >= n:
+                break
+            r, mirror = cursor, -1
+        g = len(rep_index)
+        rep_index.append(r)
+        mirror_of.append(mirror)
+        group[r] = g
+        if degenerate[r]:
+            group[degenerate & (key_of == key_of[r]) & (group < 0)] = g
+            reps.append(None)
+            continue
+        rep = _Rep(elements[r], r, coarse)
+        reps.append(rep)
+        b[r] = rep.origin
+        members, tree = trees[key_of[r]]
+        cands = members[np.array(tree.query_ball_point(desc[r], tol, p=np.inf), dtype=int)]
+        cands = np.sort(cands[group[cands] < 0])
+        flipped: list[np.ndarray] = []
+        for lo in range(0, cands.size, _CHUNK):
+            check(cancel)
+            chunk = cands[lo : lo + _CHUNK]
+            ok, phi, gap, pa, pb = matcher.match(rep, chunk, threshold, mirrored=False)
+            if flips and mirror < 0:
+                mirrored = matcher.prefer_mirror(rep, chunk, threshold, ok, phi, gap)
+                flipped.append(chunk[mirrored])
+                ok &= ~mirrored
+            group[chunk[ok]] = g
+            a[chunk[ok]], b[chunk[ok]] = pa[ok], pb[ok]
+        found = np.concatenate(flipped) if flipped else np.zeros(0, int)
+        if found.size:
+            pending.append((int(found.min()), g))
+        report(progress, _STAGE, 0.95 * float(np.count_nonzero(group >= 0)) / n)
+    symmetry = np.ones(len(rep_index), dtype=int)
+    terminals = []
+    for g, (r, rep) in enumerate(zip(rep_index, reps, strict=True)):
+        origin = rep.origin if rep is not None else complex(b[r])
+        name = terminal_name(g)
+        other = terminal_name(mirror_of[g]) if mirror_of[g] >= 0 else None
+        terminals.append(Terminal(name, _path_data(elements[r], origin), elements[r].style, other))
+        if rep is None:
+            symmetry[g] = 0
+            continue
+        order, period = symmetry_order(rep.dense, rep.dense_normals)
+        symmetry[g] = order
+        sel = group == g
+        a[sel] = _canonical(a[sel], period)
+        a[r], b[r] = 1.0, origin
+    report(progress, _STAGE, 1.0)
+    return Instancing(group, a, b, tuple(terminals), symmetry, np.array(mirror_of, dtype=int))

@@ -1,0 +1,332 @@
+"""Match a batch of candidate elements against one representative (§4.1, steps 4–7).
+
+Helpers of :mod:`lsys_core.similarity`.  Both shapes are centred on their centroids and
+normalised by their RMS radius (the paper normalises by the largest sample distance; the
+RMS radius is as cheap and steadier under resampling).  Sample pairs of similar radius and
+curvature each imply a rotation (from the normals) and a residual translation; the votes
+go into a 3D grid ``(angle, tx, ty)`` whose smoothed mode gives the transform.  It is then
+refined by batched ICP (point-to-line, closed-form least squares over the complex
+similarity) against densely sampled representative, and the similarity ``φ`` is the share
+of samples the refined transform puts on the other shape (both ways, the smaller).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.ndimage import uniform_filter1d
+from scipy.spatial import cKDTree
+
+__all__ = ["PERFECT", "Batch", "MatchResult", "Reference", "match_batch"]
+
+#: A fit gap (RMS point-to-line distance, in RMS radii) below which a match is taken as exact.
+PERFECT = 2e-3
+
+_ANGLE_BINS = 36
+_T_BINS = 6
+_T_RANGE = 0.3
+_RADIUS_TOL = 0.06
+_CURV_TOL = 0.2
+_PAIR_CAP = 24
+_INLIER = 0.03
+_NORMAL_COS = 0.5
+_P2P_WEIGHT = 0.1
+_FAR = 1.0
+_VOTE_STRIDE = 2
+_COARSE_STRIDE = 3
+_COARSE_ITERS = 6
+_FINE_ITERS = 10
+_CONVERGED = 1e-9
+
+
+@dataclass(frozen=True, eq=False)
+class Reference:
+    """A representative shape in its normalised local frame (centroid 0, RMS radius 1).
+
+    ``points``/``normals``/``curvature`` are the coarse samples used for voting;
+    ``dense``/``dense_normals`` (a superset, in arc-length order) and ``tree`` serve ICP and
+    scoring; ``dense_step`` is the arc length between dense samples.
+    """
+
+    points: np.ndarray
+    normals: np.ndarray
+    curvature: np.ndarray
+    dense: np.ndarray
+    dense_normals: np.ndarray
+    tree: cKDTree
+    order: np.ndarray
+    radius_sorted: np.ndarray
+    dense_step: float
+
+    @classmethod
+    def build(cls, points, normals, curvature, dense, dense_normals, length: float) -> Reference:
+        """Build a reference from normalised coarse and dense samples and its normalised length."""
+        rho = np.abs(points)
+        order = np.argsort(rho, kind="stable")
+        tree = cKDTree(np.column_stack([dense.real, dense.imag]))
+        step = length / dense.size
+        return cls(points, normals, curvature, dense, dense_normals, tree, order, rho[order], step)
+
+
+@dataclass(frozen=True, eq=False)
+class Batch:
+    """Candidates in their own normalised frames: ``points``, ``normals``, ``curvature`` (b, s)."""
+
+    points: np.ndarray
+    normals: np.ndarray
+    curvature: np.ndarray
+
+    def mirrored(self) -> Batch:
+        """Return the candidates flipped about their x axis."""
+        return Batch(np.conj(self.points), np.conj(self.normals), self.curvature)
+
+
+@dataclass(frozen=True, eq=False)
+class MatchResult:
+    """Per candidate: similarity ``phi``, fit ``gap`` and the map ``rep ≈ c * cand + d`` (normalised)."""
+
+    phi: np.ndarray
+    gap: np.ndarray
+    c: np.ndarray
+    d: np.ndarray
+
+
+def _votes(ref: Reference, batch: Batch, stride: int):
+    """Cast the transform votes of all radius- and curvature-compatible sample pairs."""
+    q = batch.points[:, ::stride]
+    b, s = q.shape
+    rho_q = np.abs(q).ravel()
+    lo = np.searchsorted(ref.radius_sorted, rho_q - _RADIUS_TOL, side="left")
+    hi = np.searchsorted(ref.radius_sorted, rho_q + _RADIUS_TOL, side="right")
+    span = hi - lo
+    take = np.minimum(span, _PAIR_CAP)
+    qi = np.repeat(np.arange(rho_q.size), take)
+    within = np.arange(qi.size) - np.repeat(np.cumsum(take) - take, take)
+    step = np.where(take > 0, span / np.maximum(take, 1), 0.0)
+    pi = ref.order[lo[qi] + (within * step[qi]).astype(np.int64)]
+    kq = np.arctan(batch.curvature[:, ::stride].ravel()[qi])
+    kp = np.arctan(ref.curvature[pi])
+    keep = np.abs(kq - kp) < _CURV_TOL
+    qi, pi = qi[keep], pi[keep]
+    rot = batch.normals[:, ::stride].ravel()[qi] * np.conj(ref.normals[pi])
+    rot = rot / np.maximum(np.abs(rot), 1e-300)
+    rot = np.concatenate([rot, -rot])  # the drawing direction may differ: both normal senses
+    qi = np.concatenate([qi, qi])
+    pi = np.concatenate([pi, pi])
+    t = q.ravel()[qi] - rot * ref.points[pi]
+    inside = (np.abs(t.real) < _T_RANGE) & (np.abs(t.imag) < _T_RANGE)
+    return qi[inside] // s, rot[inside], t[inside]
+
+
+def _vote_grid(cand, rot, t, b):
+    """Bin the votes and return bin indices and the smoothed ``(b, A, T, T)`` counts."""
+    ab = np.floor((np.angle(rot) % (2 * np.pi)) / (2 * np.pi) * _ANGLE_BINS).astype(np.int64) % _ANGLE_BINS
+    scale = _T_BINS / (2 * _T_RANGE)
+    xb = np.clip(((t.real + _T_RANGE) * scale).astype(np.int64), 0, _T_BINS - 1)
+    yb = np.clip(((t.imag + _T_RANGE) * scale).astype(np.int64), 0, _T_BINS - 1)
+    flat = ((cand * _ANGLE_BINS + ab) * _T_BINS + xb) * _T_BINS + yb
+    grid = np.bincount(flat, minlength=b * _ANGLE_BINS * _T_BINS * _T_BINS).astype(np.float32)
+    grid = grid.reshape(b, _ANGLE_BINS, _T_BINS, _T_BINS)
+    grid = uniform_filter1d(grid, 3, axis=1, mode="wrap")
+    grid = uniform_filter1d(grid, 3, axis=2, mode="constant")
+    grid = uniform_filter1d(grid, 3, axis=3, mode="constant")
+    return (ab, xb, yb), grid
+
+
+class _VoteSpace:
+    """The smoothed vote grids of a batch, from which successive distinct peaks are taken."""
+
+    def __init__(self, ref: Reference, batch: Batch):
+        b = batch.points.shape[0]
+        self.cand, self.rot, self.t = _votes(ref, batch, _VOTE_STRIDE)
+        self.bins, self.grid = _vote_grid(self.cand, self.rot, self.t, b)
+        self.excluded = np.zeros((b, _ANGLE_BINS), bool)
+        self.first = np.zeros(b, np.float32)
+
+    def peak(self, rows: np.ndarray):
+        """Return rotation, translation and validity of the best untried peak of ``rows``.
+
+        The peak's angle bin and its neighbours are then excluded from later peaks; a
+        peak weaker than a fifth of the first one is not valid.
+        """
+        b = rows.size
+        g = np.where(self.excluded[rows, :, None, None], -1.0, self.grid[rows]).reshape(b, -1)
+        best = np.argmax(g, axis=1)
+        val = g[np.arange(b), best]
+        if not self.first.any():
+            self.first[rows] = val
+        valid = (val > 0) & (val >= 0.2 * self.first[rows])
+        pa, rem = np.divmod(best, _T_BINS * _T_BINS)
+        px, py = np.divmod(rem, _T_BINS)
+        for k in (-2, -1, 0, 1, 2):
+            self.excluded[rows, (pa + k) % _ANGLE_BINS] = True
+        local = np.full(self.excluded.shape[0], -1)
+        local[rows] = np.arange(b)
+        sel = local[self.cand] >= 0
+        cand, rot, t = local[self.cand[sel]], self.rot[sel], self.t[sel]
+        ab, xb, yb = (x[sel] for x in self.bins)
+        da = (ab - pa[cand] + _ANGLE_BINS // 2) % _ANGLE_BINS - _ANGLE_BINS // 2
+        near = (np.abs(da) <= 1) & (np.abs(xb - px[cand]) <= 1) & (np.abs(yb - py[cand]) <= 1)
+        cn = cand[near]
+        rsum = np.bincount(cn, rot[near].real, b) + 1j * np.bincount(cn, rot[near].imag, b)
+        tsum = np.bincount(cn, t[near].real, b) + 1j * np.bincount(cn, t[near].imag, b)
+        cnt = np.bincount(cn, minlength=b)
+        rot0 = np.where(np.abs(rsum) > 0, rsum / np.maximum(np.abs(rsum), 1e-300), 1.0)
+        t0 = np.where(cnt > 0, tsum / np.maximum(cnt, 1), 0.0)
+        return rot0, t0, valid
+
+
+def _nearest(ref: Reference, x: np.ndarray):
+    """Return distances, indices (clipped) and whether found, of the nearest dense samples."""
+    pts = np.column_stack([x.real.ravel(), x.imag.ravel()])
+    dist, nn = ref.tree.query(pts, distance_upper_bound=_FAR, workers=-1 if pts.shape[0] > 20000 else 1)
+    found = np.isfinite(dist)
+    nn = np.minimum(nn, ref.dense.size - 1)
+    return dist.reshape(x.shape), nn.reshape(x.shape), found.reshape(x.shape)
+
+
+def _icp(ref: Reference, q: np.ndarray, qn: np.ndarray, c: np.ndarray, d: np.ndarray, iters: int):
+    """Refine ``rep ≈ c * q + d`` for every candidate by trimmed point-to-line ICP.
+
+    Each step solves the 4-unknown linear least squares of the point-to-line distances
+    (plus a small point-to-point term that keeps it well posed on circles and lines) in
+    closed form for all candidates at once.
+
+    Returns
+    -------
+    c, d : ndarray of complex
+        The refined maps.
+    dist, nn, found : ndarray, shape (b, s)
+        Nearest dense samples of the mapped candidate samples under the refined maps.
+    """
+    b, s = q.shape
+    active = np.ones(b, bool)
+    dist = np.zeros((b, s))
+    nn = np.zeros((b, s), np.int64)
+    found = np.zeros((b, s), bool)
+    lam = _P2P_WEIGHT
+    for _ in range(iters):
+        idx = np.flatnonzero(active)
+        if idx.size == 0:
+            break
+        qa, na = q[idx], qn[idx]
+        di, ni, fi = _nearest(ref, c[idx, None] * qa + d[idx, None])
+        dist[idx], nn[idx], found[idx] = di, ni, fi
+        r, n = ref.dense[ni], ref.dense_normals[ni]
+        rot = c[idx] / np.maximum(np.abs(c[idx]), 1e-300)
+        compat = np.abs((rot[:, None] * na * np.conj(n)).real) > _NORMAL_COS
+        tau = np.maximum(3.0 * np.median(np.where(fi, di, _FAR), axis=1), _INLIER)
+        w = fi & (di < tau[:, None]) & compat
+        w = np.where(w.sum(axis=1, keepdims=True) >= 4, w, fi).astype(float)
+        qn_ = qa * np.conj(n)
+        one, zero = np.ones_like(qa.real), np.zeros_like(qa.real)
+        jac = np.concatenate(
+            [
+                np.stack([qn_.real, -qn_.imag, n.real, n.imag], axis=-1),
+                lam * np.stack([qa.real, -qa.imag, one, zero], axis=-1),
+                lam * np.stack([qa.imag, qa.real, zero, one], axis=-1),
+            ],
+            axis=1,
+        )
+        tgt = np.concatenate([(r * np.conj(n)).real, lam * r.real, lam * r.imag], axis=1)
+        wj = (jac * np.tile(w, 3)[..., None]).transpose(0, 2, 1)
+        a_mat = wj @ jac + np.eye(4) * 1e-12
+        with np.errstate(all="ignore"):
+            sol = np.linalg.solve(a_mat, wj @ tgt[..., None])[..., 0]
+        c_new = sol[:, 0] + 1j * sol[:, 1]
+        d_new = sol[:, 2] + 1j * sol[:, 3]
+        ok = np.isfinite(sol).all(axis=1) & (np.abs(c_new) > 1e-6)
+        change = np.abs(c_new - c[idx]) + np.abs(d_new - d[idx])
+        c[idx] = np.where(ok, c_new, c[idx])
+        d[idx] = np.where(ok, d_new, d[idx])
+        active[idx] = ok & (change > _CONVERGED)
+    idx = np.flatnonzero(active)
+    if idx.size:
+        dist[idx], nn[idx], found[idx] = _nearest(ref, c[idx, None] * q[idx] + d[idx, None])
+    return c, d, dist, nn, found
+
+
+def _score(ref: Reference, q, qn, c, d, dist, nn, found, perimeter):
+    """Return ``φ`` (the smaller share of either shape's samples lying on the other) and the fit gap.
+
+    The forward share counts candidate samples within ``_INLIER`` of the representative
+    (with compatible normals).  The reverse share counts the representative's dense
+    samples that lie, along its outline, within reach of a matched candidate sample.
+    The gap is the RMS point-to-line distance of the matched samples (``_FAR`` if none).
+    """
+    b, s = q.shape
+    rot = c / np.maximum(np.abs(c), 1e-300)
+    n = ref.dense_normals[nn]
+    compat = np.abs((rot[:, None] * qn * np.conj(n)).real) > _NORMAL_COS
+    inl = found & (dist < _INLIER) & compat
+    forward = inl.mean(axis=1)
+    line = ((c[:, None] * q + d[:, None] - ref.dense[nn]) * np.conj(n)).real
+    cnt = inl.sum(axis=1)
+    gap = np.where(cnt > 0, np.sqrt(np.sum(np.where(inl, line * line, 0.0), axis=1) / np.maximum(cnt, 1)), _FAR)
+    m = ref.dense.size
+    hits = np.zeros((b, m), np.int32)
+    rows = np.repeat(np.arange(b), s)
+    hits[rows[inl.ravel()], nn[inl]] = 1
+    reach = (0.6 * perimeter * np.abs(c) / s + _INLIER) / ref.dense_step
+    w = np.clip(np.ceil(reach).astype(np.int64), 1, m // 2)
+    wmax = int(w.max())
+    padded = np.concatenate([hits[:, m - wmax :], hits, hits[:, :wmax]], axis=1)
+    cs = np.zeros((b, m + 2 * wmax + 1), np.int32)
+    np.cumsum(padded, axis=1, out=cs[:, 1:])
+    backward = np.empty(b)
+    for wv in np.unique(w):
+        sel = w == wv
+        lo = wmax - wv
+        covered = cs[sel, lo + 2 * wv + 1 : lo + 2 * wv + 1 + m] - cs[sel, lo : lo + m]
+        backward[sel] = (covered > 0).mean(axis=1)
+    return np.minimum(forward, backward), gap
+
+
+def match_batch(ref: Reference, batch: Batch, perimeter: np.ndarray, *, peaks: int = 3) -> MatchResult:
+    """Vote, refine and score candidates against a representative.
+
+    Parameters
+    ----------
+    ref : Reference
+        The representative in its normalised frame.
+    batch : Batch
+        Candidates in their normalised frames (centroid 0, RMS radius 1).
+    perimeter : ndarray of float, shape (b,)
+        Arc length of each candidate in its normalised frame.
+    peaks : int
+        How many distinct vote peaks (rotations) to refine per candidate; the one whose
+        refinement fits best wins (nearly symmetric shapes have several strong peaks).
+
+    Returns
+    -------
+    MatchResult
+        ``phi`` and the refined ``rep ≈ c * cand + d`` per candidate.
+    """
+    b = batch.points.shape[0]
+    space = _VoteSpace(ref, batch)
+    qs = batch.points[:, ::_COARSE_STRIDE]
+    ns = batch.normals[:, ::_COARSE_STRIDE]
+    c1 = np.ones(b, complex)
+    d1 = np.zeros(b, complex)
+    key = np.full(b, -np.inf)
+    rows = np.arange(b)
+    for attempt in range(peaks):
+        if rows.size == 0:
+            break
+        r0, t0, valid = space.peak(rows)
+        if attempt:
+            rows, r0, t0 = rows[valid], r0[valid], t0[valid]
+            if rows.size == 0:
+                break
+        c0 = np.conj(r0)
+        c, d, dist, nn, found = _icp(ref, qs[rows], ns[rows], c0, -c0 * t0, _COARSE_ITERS)
+        sc, gap = _score(ref, qs[rows], ns[rows], c, d, dist, nn, found, perimeter[rows] * _COARSE_STRIDE)
+        k = sc - 2.0 * gap
+        better = k > key[rows]
+        sel = rows[better]
+        c1[sel], d1[sel], key[sel] = c[better], d[better], k[better]
+        rows = rows[(sc < 1.0) | (gap >= PERFECT)]
+    c2, d2, dist, nn, found = _icp(ref, batch.points, batch.normals, c1, d1, _FINE_ITERS)
+    phi, gap = _score(ref, batch.points, batch.normals, c2, d2, dist, nn, found, perimeter)
+    return MatchResult(phi, gap, c2, d2)

@@ -1,0 +1,87 @@
+"""Transformation spaces (§4.3): relative transforms between pairs of live nodes.
+
+Instead of all n² pairs, each node is paired with its ``k`` nearest neighbours among the
+nodes alive at the current level of the hierarchy.  Because nodes are merged level by
+level (a row becomes one node, then rows pair with rows), long-range structure is found
+among the few nodes of the upper levels, where "nearest" spans the whole picture.
+Every point keeps its back-links ``src``/``dst`` to the two nodes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+__all__ = ["PairSpace", "pair_space"]
+
+
+@dataclass(frozen=True, eq=False)
+class PairSpace:
+    """Points of all transformation spaces at one level.
+
+    Attributes
+    ----------
+    src, dst : ndarray of int
+        Back-links: the pair's first and second node.
+    A, B : ndarray of complex
+        Relative frame of ``dst`` seen from ``src`` (:func:`lsys_core.geometry.relative`).
+    alpha, d, s, beta : ndarray of float
+        The paper's ``+(alpha) f(d) *(s) +(beta)`` (degrees).
+    gap : ndarray of float
+        Distance between the two nodes' outlines (bounding-circle approximation, >= 0).
+    """
+
+    src: np.ndarray
+    dst: np.ndarray
+    A: np.ndarray
+    B: np.ndarray
+    alpha: np.ndarray
+    d: np.ndarray
+    s: np.ndarray
+    beta: np.ndarray
+    gap: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.src.size)
+
+
+def pair_space(a: np.ndarray, b: np.ndarray, center: np.ndarray, radius: np.ndarray, k: int = 12) -> PairSpace:
+    """Build the directed pairs between every node and its ``k`` nearest neighbours.
+
+    Parameters
+    ----------
+    a, b : ndarray of complex
+        Node frames.
+    center : ndarray of complex
+        Centres of the nodes' covered geometry (document coordinates).
+    radius : ndarray of float
+        Radii of the nodes' covered geometry.
+    k : int
+        Neighbours per node (both directions of every pair are kept).
+    """
+    from .geometry import t4_from_rel
+
+    n = a.size
+    if n < 2:
+        e = np.zeros(0, int)
+        z = np.zeros(0)
+        return PairSpace(e, e, z.astype(complex), z.astype(complex), z, z, z, z, z)
+    kk = min(k, n - 1)
+    pts = np.column_stack([center.real, center.imag])
+    _, idx = cKDTree(pts).query(pts, k=kk + 1)
+    idx = np.atleast_2d(idx)
+    src = np.repeat(np.arange(n), kk + 1)
+    dst = idx.ravel()
+    keep = (dst != src) & (dst < n)
+    src, dst = src[keep], dst[keep]
+    # Symmetrise: keep both directions of every neighbour pair, once each.
+    both = np.concatenate([src * n + dst, dst * n + src])
+    both = np.unique(both)
+    src, dst = both // n, both % n
+    A = a[dst] / a[src]
+    B = (b[dst] - b[src]) / a[src]
+    alpha, d, s, beta = t4_from_rel(A, B)
+    gap = np.maximum(np.abs(center[dst] - center[src]) - radius[src] - radius[dst], 0.0)
+    return PairSpace(src, dst, A, B, alpha, d, s, beta, gap)
