@@ -517,9 +517,8 @@ class Canvas(QWidget):
         d = self.drawing
         if d is None:
             return None
-        if len(d):
-            return core.drawing_bounds(d)
-        if d.viewbox is not None:
+        bounds = core.drawing_bounds(d) if len(d) else None
+        if bounds is None and d.viewbox is not None:
             x, y, w, h = d.viewbox
             return x, y, x + w, y + h
-        return None
+        return bounds

@@ -195,26 +195,22 @@ def read_text(path: str) -> str:
 _TERMINAL_DISCS: dict[tuple[str, ...], tuple[Any, Any]] = {}
 
 
-def _terminal_discs(terminals: tuple) -> tuple[Any, Any]:
-    """Return the centre (complex) and radius of every terminal's bounding box in its local frame."""
+def _terminal_discs(drawing: Any) -> tuple[Any, Any]:
+    """Return the centre (complex) and radius of a disc around every terminal's control points."""
     import numpy as np
 
-    from lsys_core.svg.pathdata import cubics_bounds, cubics_from_d
+    from lsys_core.svg.export import terminal_points
 
-    key = tuple(t.path for t in terminals)
+    key = tuple(t.path for t in drawing.terminals)
     cached = _TERMINAL_DISCS.get(key)
     if cached is None:
-        centers = np.zeros(len(terminals), complex)
-        radii = np.zeros(len(terminals))
-        for i, t in enumerate(terminals):
-            try:
-                cubics = cubics_from_d(t.path)[0]
-            except LsysError:
-                continue
-            if len(cubics):
-                x0, y0, x1, y1 = cubics_bounds(cubics)
-                centers[i] = complex((x0 + x1) / 2, (y0 + y1) / 2)
-                radii[i] = 0.5 * float(np.hypot(x1 - x0, y1 - y0))
+        points = terminal_points(drawing)
+        centers = np.zeros(len(points), complex)
+        radii = np.zeros(len(points))
+        for i, p in enumerate(points):
+            if p.size:
+                centers[i] = complex((p.real.min() + p.real.max()) / 2, (p.imag.min() + p.imag.max()) / 2)
+                radii[i] = float(np.abs(p - centers[i]).max())
         if len(_TERMINAL_DISCS) > 64:
             _TERMINAL_DISCS.clear()
         cached = _TERMINAL_DISCS[key] = (centers, radii)
@@ -223,29 +219,21 @@ def _terminal_discs(terminals: tuple) -> tuple[Any, Any]:
 
 def instance_centers(drawing: Any) -> Any:
     """Return the centre of every instance's bounding disc in document coordinates (for picking)."""
-    centers, _ = _terminal_discs(drawing.terminals)
+    centers, _ = _terminal_discs(drawing)
     return drawing.a * centers[drawing.symbol] + drawing.b
 
 
 def instance_radius(drawing: Any, index: int) -> float:
     """Return the radius of instance ``index``'s bounding disc in document units."""
-    _, radii = _terminal_discs(drawing.terminals)
+    _, radii = _terminal_discs(drawing)
     return float(abs(drawing.a[index]) * radii[drawing.symbol[index]])
 
 
-def drawing_bounds(drawing: Any) -> tuple[float, float, float, float]:
-    """Return ``(x0, y0, x1, y1)`` enclosing every instance's bounding disc."""
-    import numpy as np
+def drawing_bounds(drawing: Any) -> tuple[float, float, float, float] | None:
+    """Return ``(x0, y0, x1, y1)`` of the drawing's instances, strokes included (None if empty)."""
+    from lsys_core.svg.export import drawing_bounds as _bounds
 
-    centers, radii = _terminal_discs(drawing.terminals)
-    c = drawing.a * centers[drawing.symbol] + drawing.b
-    r = np.abs(drawing.a) * radii[drawing.symbol]
-    return (
-        float((c.real - r).min()),
-        float((c.imag - r).min()),
-        float((c.real + r).max()),
-        float((c.imag + r).max()),
-    )
+    return _bounds(drawing)
 
 
 def axiom_count(grammar: Any) -> int | None:

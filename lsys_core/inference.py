@@ -74,6 +74,7 @@ class Hierarchy:
     levels: int
     node_rule: np.ndarray  # for every input element: index of the first rule that covered it (-1: axiom)
     log: list[str] = field(default_factory=list)
+    closed: bool = True  # False when a last rule had to place nodes no repetition explains
 
 
 @dataclass
@@ -94,6 +95,11 @@ class _Candidate:
 def _t_modules(alpha: Linear, d: Linear, s: Linear, beta: Linear) -> tuple[Module, ...]:
     """Return ``+(α) f(d) *(s) +(β)`` without identity commands."""
     out: list[Module] = []
+    if alpha.cd == 0 and beta.cd == 0 and d.cd == 0 and abs(float(wrap_deg(alpha.c0))) > 90.0:
+        # +(α) f(d) … +(β) == +(α-180) f(-d) … +(β+180): keep the turn small.
+        alpha = Linear(float(wrap_deg(alpha.c0 - 180.0)))
+        d = Linear(-d.c0)
+        beta = Linear(float(wrap_deg(beta.c0 + 180.0)))
 
     def angle(v: Linear) -> None:
         c0 = float(wrap_deg(v.c0)) if v.cd == 0 else v.c0
@@ -268,7 +274,7 @@ def build_hierarchy(
         for mem in members:
             node_rule[mem[node_rule[mem] < 0]] = len(bld.rules) - 1
     report(progress, "rules", 1.0)
-    return Hierarchy(bld.rules, axiom, level, node_rule, bld.log)
+    return Hierarchy(bld.rules, axiom, level, node_rule, bld.log, closed=a.size == 1)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -13,16 +13,27 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .cancel import CancelToken, Progress, check, report
+from .derive import derive
 from .errors import InferenceError
 from .grammar.model import Grammar
 from .inference import Tolerance, Weights, build_hierarchy
 from .model import Instancing, Scene
+from .pivots import estimate_pivots, recenter
 from .postprocess import simplify
 
 __all__ = ["InferenceResult", "InferenceSettings", "infer", "symmetrize"]
 
 #: Bandwidth factor used by :func:`symmetrize` (the paper's "relaxed sensitivity").
 RELAXED = 12.0
+#: Largest reproduction error (relative to the scene's diagonal) :func:`infer` accepts
+#: when it relaxes the clustering to explain jittered repetitions.
+INFER_ERROR = 0.004
+#: A relaxed grammar may deviate up to this much if it needs at most :data:`JITTER_GAIN`
+#: times the productions of the exact one (jittered repetitions, paper Fig. 10).
+JITTER_ERROR = 0.025
+JITTER_GAIN = 0.7
+#: The same for :func:`symmetrize`, whose purpose is to move elements onto a regular pattern.
+SYMMETRIZE_ERROR = 0.03
 
 
 @dataclass(frozen=True)
@@ -102,12 +113,51 @@ def _shape_similarity(inst: Instancing) -> np.ndarray:
     return sim
 
 
+def _diagonal(center: np.ndarray, radius: np.ndarray) -> float:
+    lo = np.array([np.min(center.real - radius), np.min(center.imag - radius)])
+    hi = np.array([np.max(center.real + radius), np.max(center.imag + radius)])
+    return max(float(np.hypot(*(hi - lo))), 1e-12)
+
+
+def _factors(settings: InferenceSettings, symmetrizing: bool) -> list[float]:
+    """Bandwidth factors to try: the user's tolerance first, then relaxed ones."""
+    if symmetrizing:
+        return [settings.tolerance * f for f in (1.0, 2.0)]
+    return [settings.tolerance * f for f in (1.0, 3.0, 5.0, 9.0, 15.0)]
+
+
+def reproduction_error(inst: Instancing, sizes: np.ndarray, drawing) -> float:
+    """Largest displacement of an input element in ``drawing`` (document units).
+
+    Each input element is matched to the nearest derived instance of its terminal; the
+    displacement counts the translation and the rotation/scale change at the shape's radius.
+    Missing instances count as infinitely far.
+    """
+    from scipy.spatial import cKDTree
+
+    worst = 0.0
+    for g in range(len(inst.terminals)):
+        mine = np.flatnonzero(inst.group == g)
+        theirs = np.flatnonzero(drawing.symbol == g)
+        if mine.size != theirs.size:
+            return float("inf")
+        if mine.size == 0:
+            continue
+        tb = drawing.b[theirs]
+        _, j = cKDTree(np.column_stack([tb.real, tb.imag])).query(
+            np.column_stack([inst.b[mine].real, inst.b[mine].imag]))
+        err = np.abs(inst.b[mine] - tb[j]) + sizes[g] * np.abs(inst.a[mine] - drawing.a[theirs][j])
+        worst = max(worst, float(err.max()))
+    return worst
+
+
 def infer(
     scene: Scene,
     settings: InferenceSettings = InferenceSettings(),
     *,
     cancel: CancelToken | None = None,
     progress: Progress | None = None,
+    symmetrizing: bool = False,
 ) -> InferenceResult:
     """Infer a compact L-system that regenerates ``scene`` (paper §4–§5).
 
@@ -121,6 +171,16 @@ def infer(
         Checked between stages and levels; raises :class:`~lsys_core.errors.Cancelled`.
     progress : callable, optional
         ``progress(stage, fraction)`` for the stages ``similarity`` and ``rules``.
+    symmetrizing : bool
+        Used by :func:`symmetrize`: relaxed bandwidths, larger accepted deviation.
+
+    Notes
+    -----
+    If the rules found at the user's tolerance leave elements unexplained by any
+    repetition, the clustering is relaxed (×3 … ×15) and the grammar with the fewest
+    productions is kept among those that deviate at most :data:`INFER_ERROR` from the
+    input, or at most :data:`JITTER_ERROR` when they need clearly fewer productions
+    (a jittered pattern).
 
     Returns
     -------
@@ -140,17 +200,39 @@ def infer(
     center, radius = _element_circles(scene)
     sizes = np.zeros(len(inst.terminals))
     np.maximum.at(sizes, inst.group, radius / np.maximum(np.abs(inst.a), 1e-300))
-    weights = Weights(settings.wn, settings.wh, settings.wphi, settings.wl)
-    tol = Tolerance().scaled(settings.tolerance)
-    hier = build_hierarchy(
-        [t.name for t in inst.terminals], sizes, inst.group, inst.a, inst.b, center, radius,
-        weights=weights, tol=tol, similarity=_shape_similarity(inst), neighbours=settings.neighbours,
-        cancel=cancel, progress=progress, timer=stages,
-    )
     t = time.perf_counter()
-    grammar = Grammar(inst.terminals, tuple(hier.rules), hier.axiom, scene.viewbox, scene.size)
-    grammar = simplify(grammar)
-    stages["postprocess"] = time.perf_counter() - t
+    inst = recenter(inst, estimate_pivots(inst, sizes))
+    stages["pivots"] = time.perf_counter() - t
+    weights = Weights(settings.wn, settings.wh, settings.wphi, settings.wl)
+    diag = _diagonal(center, radius)
+    best = None
+    first_count: int | None = None
+    for factor in _factors(settings, symmetrizing):
+        check(cancel)
+        hier = build_hierarchy(
+            [t.name for t in inst.terminals], sizes, inst.group, inst.a, inst.b, center, radius,
+            weights=weights, tol=Tolerance().scaled(factor), similarity=_shape_similarity(inst),
+            neighbours=settings.neighbours, cancel=cancel, progress=progress, timer=stages,
+        )
+        t = time.perf_counter()
+        grammar = simplify(Grammar(inst.terminals, tuple(hier.rules), hier.axiom, scene.viewbox, scene.size))
+        error = reproduction_error(inst, sizes, derive(grammar, limit=max(10 * len(scene.elements), 1000))) / diag
+        stages["postprocess"] = stages.get("postprocess", 0.0) + time.perf_counter() - t
+        count = grammar.production_count
+        if best is None:
+            ok = True
+        elif symmetrizing:
+            ok = error <= SYMMETRIZE_ERROR
+        else:
+            ok = error <= INFER_ERROR or (error <= JITTER_ERROR and count <= JITTER_GAIN * first_count)
+        if ok and (best is None or (count, error) < (best[0].production_count, best[2])):
+            best = (grammar, hier, error)
+        if best is not None and first_count is None:
+            first_count = count
+        if hier.closed and not symmetrizing:
+            break  # every element is explained by repetitions: no need to relax
+    grammar, hier, error = best
+    stages["reproduction_error"] = error
     report(progress, "done", 1.0)
     return InferenceResult(grammar, inst, stages, time.perf_counter() - t_all, hier.node_rule, tuple(hier.log))
 
@@ -164,4 +246,4 @@ def symmetrize(
     progress: Progress | None = None,
 ) -> InferenceResult:
     """Infer with relaxed clustering so jittered repetitions share one mean transform (Fig. 10)."""
-    return infer(scene, settings.relaxed(factor), cancel=cancel, progress=progress)
+    return infer(scene, settings.relaxed(factor), cancel=cancel, progress=progress, symmetrizing=True)

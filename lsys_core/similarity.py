@@ -253,7 +253,7 @@ class _Matcher:
                 flip(self.coarse.normals[sub]),
                 self.coarse.curvature[sub] * r[:, None],
             )
-            res = match_batch(rep.ref, batch, self.coarse.length[sub] / r)
+            res = match_batch(rep.ref, batch, self.coarse.length[sub] / r, threshold=threshold)
             # rep ≈ c * cand + d (normalised)  =>  element = a * local + b
             a[rest] = r / (rep.radius * res.c)
             b[rest] = flip(self.centroid[sub]) - a[rest] * rep.radius * res.d
@@ -335,7 +335,7 @@ def detect_similarity(
         members = np.flatnonzero((key_of == k) & ~degenerate)
         if members.size:
             trees[k] = (members, cKDTree(desc[members]))
-    tol = 0.1 + 0.3 * (1.0 - threshold)
+    tol = 0.06 + 0.15 * (1.0 - threshold)
     matcher = _Matcher(elements, coarse, centroid, np.where(degenerate, 1.0, radius))
     group = np.full(n, -1, dtype=int)
     a = np.ones(n, complex)

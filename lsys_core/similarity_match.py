@@ -36,7 +36,8 @@ _FAR = 1.0
 _VOTE_STRIDE = 2
 _COARSE_STRIDE = 3
 _COARSE_ITERS = 6
-_FINE_ITERS = 10
+_FINE_ITERS = 5
+_COARSE_MARGIN = 0.2
 _CONVERGED = 1e-9
 
 
@@ -178,7 +179,7 @@ class _VoteSpace:
 
 
 def _nearest(ref: Reference, x: np.ndarray):
-    """Return distances, indices (clipped) and whether found, of the nearest dense samples."""
+    """Return distances, indices and whether found (within ``_FAR``), of the nearest dense samples."""
     pts = np.column_stack([x.real.ravel(), x.imag.ravel()])
     dist, nn = ref.tree.query(pts, distance_upper_bound=_FAR, workers=-1 if pts.shape[0] > 20000 else 1)
     found = np.isfinite(dist)
@@ -283,7 +284,9 @@ def _score(ref: Reference, q, qn, c, d, dist, nn, found, perimeter):
     return np.minimum(forward, backward), gap
 
 
-def match_batch(ref: Reference, batch: Batch, perimeter: np.ndarray, *, peaks: int = 3) -> MatchResult:
+def match_batch(
+    ref: Reference, batch: Batch, perimeter: np.ndarray, *, threshold: float = 0.6, peaks: int = 3
+) -> MatchResult:
     """Vote, refine and score candidates against a representative.
 
     Parameters
@@ -294,6 +297,9 @@ def match_batch(ref: Reference, batch: Batch, perimeter: np.ndarray, *, peaks: i
         Candidates in their normalised frames (centroid 0, RMS radius 1).
     perimeter : ndarray of float, shape (b,)
         Arc length of each candidate in its normalised frame.
+    threshold : float
+        The similarity that decides; candidates whose coarse fit stays far below it are
+        not refined further (their ``phi`` is the coarse estimate).
     peaks : int
         How many distinct vote peaks (rotations) to refine per candidate; the one whose
         refinement fits best wins (nearly symmetric shapes have several strong peaks).
@@ -301,7 +307,7 @@ def match_batch(ref: Reference, batch: Batch, perimeter: np.ndarray, *, peaks: i
     Returns
     -------
     MatchResult
-        ``phi`` and the refined ``rep ≈ c * cand + d`` per candidate.
+        ``phi``, ``gap`` and the refined ``rep ≈ c * cand + d`` per candidate.
     """
     b = batch.points.shape[0]
     space = _VoteSpace(ref, batch)
@@ -310,6 +316,8 @@ def match_batch(ref: Reference, batch: Batch, perimeter: np.ndarray, *, peaks: i
     c1 = np.ones(b, complex)
     d1 = np.zeros(b, complex)
     key = np.full(b, -np.inf)
+    best = np.zeros(b)
+    gap1 = np.full(b, _FAR)
     rows = np.arange(b)
     for attempt in range(peaks):
         if rows.size == 0:
@@ -325,8 +333,15 @@ def match_batch(ref: Reference, batch: Batch, perimeter: np.ndarray, *, peaks: i
         k = sc - 2.0 * gap
         better = k > key[rows]
         sel = rows[better]
-        c1[sel], d1[sel], key[sel] = c[better], d[better], k[better]
-        rows = rows[(sc < 1.0) | (gap >= PERFECT)]
-    c2, d2, dist, nn, found = _icp(ref, batch.points, batch.normals, c1, d1, _FINE_ITERS)
-    phi, gap = _score(ref, batch.points, batch.normals, c2, d2, dist, nn, found, perimeter)
-    return MatchResult(phi, gap, c2, d2)
+        c1[sel], d1[sel], key[sel], best[sel], gap1[sel] = c[better], d[better], k[better], sc[better], gap[better]
+        # another peak only for imperfect fits that are not hopeless
+        rows = rows[((sc < 1.0) | (gap >= PERFECT)) & (best[rows] >= 0.5 * threshold)]
+    phi, gap = best.copy(), gap1
+    fine = np.flatnonzero(best >= threshold - _COARSE_MARGIN)
+    if fine.size:
+        c2, d2, dist, nn, found = _icp(ref, batch.points[fine], batch.normals[fine], c1[fine], d1[fine], _FINE_ITERS)
+        phi[fine], gap[fine] = _score(
+            ref, batch.points[fine], batch.normals[fine], c2, d2, dist, nn, found, perimeter[fine]
+        )
+        c1[fine], d1[fine] = c2, d2
+    return MatchResult(phi, gap, c1, d1)

@@ -126,9 +126,10 @@ def sample_elements(elements: list[Element] | tuple[Element, ...], fractions: np
 def element_features(samples: Samples) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Return centroid, RMS radius and a similarity-invariant descriptor of every element.
 
-    The descriptor is mirror-, start-point-, direction- and resampling-robust: sorted
-    radial distances from the centroid (normalised by the RMS radius) at nine quantiles,
-    and the log of perimeter over RMS radius.
+    The descriptor is mirror-, start-point-, direction- and resampling-robust, and moves
+    little under small deformations: the deciles (10 % … 90 %) of the radial distances
+    from the centroid (normalised by the RMS radius), and the log of perimeter over RMS
+    radius (scaled down by 4).
 
     Returns
     -------
@@ -140,9 +141,7 @@ def element_features(samples: Samples) -> tuple[np.ndarray, np.ndarray, np.ndarr
     rel = np.abs(samples.points - centroid[:, None])
     radius = np.sqrt(np.mean(rel * rel, axis=1))
     safe = np.where(radius > 0, radius, 1.0)
-    rho = np.sort(rel / safe[:, None], axis=1)
-    q = np.linspace(0, rho.shape[1] - 1, 9).round().astype(int)
-    desc = np.empty((rho.shape[0], 10))
-    desc[:, :9] = rho[:, q]
+    desc = np.empty((rel.shape[0], 10))
+    desc[:, :9] = np.quantile(rel / safe[:, None], np.linspace(0.1, 0.9, 9), axis=1).T
     desc[:, 9] = np.log1p(samples.length / safe) / 4.0
     return centroid, radius, desc

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import LimitError, SvgError
 from ..model import Element, Scene
-from .pathdata import cubics_from_path, transform_cubics
+from .pathdata import RawPath, assemble, raw_from_d, raw_from_segments
 
 __all__ = ["DEFAULT_MAX_BYTES", "DEFAULT_MAX_DEPTH", "DEFAULT_MAX_ELEMENTS", "load_svg", "parse_svg"]
 
@@ -75,6 +75,7 @@ class _Prepared:
 
     data: bytes
     names: list[str]
+    paths: dict[str, RawPath]
     expected: int
     viewbox: tuple[float, float, float, float] | None
     size: tuple[str, str] | None
@@ -249,6 +250,7 @@ def _prepare(source: str | bytes, max_elements: int, max_depth: int, name: str) 
         raise SvgError(f"not an SVG: {name}: the root element is <{root.tag}>, not <svg>")
 
     names: list[str] = []
+    paths: dict[str, RawPath] = {}
     counters: dict[str, int] = {}
     ids: dict[str, ET.Element] = {}
     uses: list[ET.Element] = []
@@ -278,8 +280,16 @@ def _prepare(source: str | bytes, max_elements: int, max_depth: int, name: str) 
         if tag in DRAWABLE or tag == "use":
             i = counters.get(tag, 0)
             counters[tag] = i + 1
-            el.set(SRC_ATTR, str(len(names)))
+            key = str(len(names))
+            el.set(SRC_ATTR, key)
             names.append(f"{tag}#{el_id}" if el_id else f"{tag}[{i}]")
+            if tag == "path":
+                # Parse path data here (fast); svgelements then only resolves the transform.
+                d = el.get("d")
+                raw = RawPath([], [], [], []) if d is None else raw_from_d(d)
+                if raw is not None:
+                    paths[key] = raw
+                    el.set("d", "")
             if tag == "use":
                 uses.append(el)
             elif not hidden:
@@ -299,7 +309,7 @@ def _prepare(source: str | bytes, max_elements: int, max_depth: int, name: str) 
     viewbox = _parse_viewbox(root.get("viewBox"))
     w, h = root.get("width"), root.get("height")
     size = (w or "100%", h or "100%") if (w is not None or h is not None) else None
-    return _Prepared(ET.tostring(root), names, expected, viewbox, size)
+    return _Prepared(ET.tostring(root), names, paths, expected, viewbox, size)
 
 
 def _remove_children(pairs: list) -> None:
@@ -400,17 +410,23 @@ def _parse_viewbox(text: str | None) -> tuple[float, float, float, float] | None
 
 
 def _extract(prepared: _Prepared, name: str) -> tuple[list[Element], _Skips]:
-    """Run svgelements on the prepared tree and convert its shapes to elements."""
-    from svgelements import SVG, Matrix
+    """Run svgelements on the prepared tree and convert its shapes to elements.
+
+    svgelements resolves structure, CSS and transforms (without ``reify``); path
+    data already parsed by :func:`_prepare` is looked up and transformed here in
+    one vectorised pass together with all other shapes.
+    """
+    from svgelements import SVG, Matrix, Path
 
     try:
-        doc = SVG.parse(io.BytesIO(prepared.data), reify=True, parse_display_none=True)
+        doc = SVG.parse(io.BytesIO(prepared.data), reify=False, parse_display_none=True)
     except RecursionError as exc:
         raise LimitError(f"{name}: the SVG is nested too deeply to read") from exc
     except (ValueError, TypeError, IndexError, KeyError, AttributeError, ZeroDivisionError, OverflowError) as exc:
         raise SvgError(f"cannot read SVG {name}: invalid attribute value ({type(exc).__name__}: {exc})") from exc
 
-    inverse = None
+    # Undo the viewBox -> viewport mapping svgelements applies: keep viewBox user units.
+    inverse = _IDENTITY
     vp_scale = 1.0
     vbt = doc.viewbox_transform if isinstance(doc, SVG) else ""
     if vbt:
@@ -418,12 +434,14 @@ def _extract(prepared: _Prepared, name: str) -> tuple[list[Element], _Skips]:
         det = m.a * m.d - m.b * m.c
         if det != 0 and math.isfinite(det):
             vp_scale = math.sqrt(abs(det))
-            if not m.is_identity():
-                inv = ~m
-                inverse = (inv.a, inv.b, inv.c, inv.d, inv.e, inv.f)
+            inv = ~m
+            inverse = (inv.a, inv.b, inv.c, inv.d, inv.e, inv.f)
 
     skips = _Skips()
-    elements: list[Element] = []
+    raws: list[RawPath] = []
+    mats: list[tuple[float, ...]] = []
+    styles: list[str] = []
+    sources: list[str] = []
     produced = 0
     for shape, chain, opacity in _shapes(doc):
         produced += 1
@@ -432,34 +450,88 @@ def _extract(prepared: _Prepared, name: str) -> tuple[list[Element], _Skips]:
             continue
         if str(values.get("visibility", "")).strip().lower() in ("hidden", "collapse"):
             continue
-        try:
-            cubics, subpaths, closed = cubics_from_path(shape.segments(transformed=True))
-        except (ValueError, TypeError, ZeroDivisionError, OverflowError, AttributeError):
-            skips.add("invalid geometry")
-            continue
-        if cubics.size == 0:
+        raw = prepared.paths.get(values.get(SRC_ATTR, "")) if type(shape) is Path else None
+        if raw is not None:
+            t = shape.transform
+            mat = (t.a, t.b, t.c, t.d, t.e, t.f)
+        else:
+            try:
+                raw = raw_from_segments(shape.segments(transformed=True))
+            except (ValueError, TypeError, ZeroDivisionError, OverflowError, AttributeError):
+                skips.add("invalid geometry")
+                continue
+            mat = _IDENTITY
+        if not raw.pts:
             skips.add("degenerate (zero size)")
             continue
-        if not np.isfinite(cubics).all() or np.abs(cubics).max() > MAX_COORD:
-            skips.add("non-finite or huge coordinates")
-            continue
-        if inverse is not None:
-            cubics = transform_cubics(cubics, inverse)
         style = _style(shape, vp_scale, opacity)
         if style is None:
-            skips.add("non-finite style values")
+            skips.add("non-finite or huge coordinates")
             continue
-        elements.append(
-            Element(
-                cubics=cubics,
-                subpaths=subpaths,
-                closed=closed,
-                style=style,
-                source=_source(values, chain, prepared.names),
-            )
-        )
+        raws.append(raw)
+        mats.append(mat)
+        styles.append(style)
+        sources.append(_source(values, chain, prepared.names))
     skips.add("degenerate (zero size)", prepared.expected - produced)
+    if not raws:
+        return [], skips
+
+    cubics, subpaths, counts = assemble(raws)
+    full = _compose(np.array(inverse, dtype=float), np.array(mats, dtype=float).reshape(-1, 6))
+    cubics = _apply(cubics, np.repeat(full, counts, axis=0))
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    with np.errstate(invalid="ignore"):
+        seg_ok = np.isfinite(cubics).all(axis=1) & (np.abs(cubics).max(axis=1) <= MAX_COORD)
+        bad = np.add.reduceat((~seg_ok).astype(np.intp), starts) > 0
+        first = cubics[starts, 0]
+        spread = np.abs(cubics - np.repeat(first, counts)[:, None]).max(axis=1)
+        extent = np.maximum.reduceat(spread, starts)
+        flat = ~bad & (extent <= 1e-12 * np.abs(first))
+    skips.add("non-finite or huge coordinates", int(bad.sum()))
+    skips.add("degenerate (zero size)", int(flat.sum()))
+    keep = ~(bad | flat)
+    cubics.flags.writeable = False
+    subpaths.flags.writeable = False
+    ends = starts + counts
+    elements = [
+        Element(
+            cubics=cubics[starts[i] : ends[i]],
+            subpaths=subpaths[starts[i] : ends[i]],
+            closed=tuple(raws[i].closed),
+            style=styles[i],
+            source=sources[i],
+        )
+        for i in np.flatnonzero(keep).tolist()
+    ]
     return elements, skips
+
+
+_IDENTITY = (1.0, 0.0, 0.0, 1.0, 0.0, 0.0)
+
+
+def _compose(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Return the affine matrices ``p @ q`` in SVG ``(a, b, c, d, e, f)`` order; ``q`` is ``(n, 6)``."""
+    pa, pb, pc, pd, pe, pf = p
+    qa, qb, qc, qd, qe, qf = q.T
+    return np.stack(
+        [
+            pa * qa + pc * qb,
+            pb * qa + pd * qb,
+            pa * qc + pc * qd,
+            pb * qc + pd * qd,
+            pa * qe + pc * qf + pe,
+            pb * qe + pd * qf + pf,
+        ],
+        axis=1,
+    )
+
+
+def _apply(cubics: np.ndarray, mats: np.ndarray) -> np.ndarray:
+    """Apply one affine matrix per segment (``mats`` is ``(k, 6)``) to the control points."""
+    x, y = cubics.real, cubics.imag
+    a, b, c, d, e, f = (mats[:, i : i + 1] for i in range(6))
+    with np.errstate(invalid="ignore", over="ignore"):
+        return (a * x + c * y + e) + 1j * (b * x + d * y + f)
 
 
 def _shapes(doc) -> Iterator[tuple[object, tuple[str, ...], float]]:
@@ -543,7 +615,7 @@ def _style(shape, vp_scale: float, opacity: float) -> str | None:
         parts.append("stroke:none")
     else:
         parts.append(f"stroke:{stroke.hexrgb}")
-        width = shape.stroke_width
+        width = shape.implicit_stroke_width
         width = 1.0 if width is None else float(width) / vp_scale
         if not math.isfinite(width):
             return None

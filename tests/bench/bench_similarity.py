@@ -49,7 +49,7 @@ SHAPES = [
     LEAF,
     _lines([0, 16, 16 - 4j, 24 + 2j, 16 + 8j, 16 + 4j, 4j]),  # arrow
     _lines([0, 14, 3 + 9j]),  # triangle
-    _lines([0, 20j, 12 + 15j, 11j]),  # hook outline
+    _lines([0, 10, 14 + 6j, 3 + 9j]),  # kite
 ]
 
 
@@ -80,7 +80,7 @@ def scene_mixed(n: int, rng) -> Scene:
     els = []
     for i in range(n):
         shape = SHAPES[i % len(SHAPES)]
-        if i % 4 == 1:
+        if (i // len(SHAPES)) % 4 == 1:
             shape = np.conj(shape)
         if i % 3 == 2:
             shape = _split(shape)

@@ -1,0 +1,81 @@
+"""Fixtures for the editor's tests: offscreen Qt, isolated settings, corpus files, a main window."""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+import threading
+from pathlib import Path
+
+import pytest
+
+CORPUS = Path(os.environ.get("LSYS_CORPUS", Path(__file__).resolve().parents[3] / "shared" / "corpus"))
+
+HELIX_LSYS = """lsys 1
+terminal A "M 0 0 Q 5 -8 14 -2 Q 9 2 0 0 Z" style "fill:none;stroke:#1b5e20;stroke-width:1"
+axiom: P(119)
+P(m): m > 0 -> A f(24) *(0.99) +(11) P(m-1)
+P(m): m == 0 -> A
+"""
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _isolated_qt_paths(tmp_path_factory):
+    """Keep QSettings and QStandardPaths (recovery files) out of the user's home."""
+    from PySide6.QtCore import QCoreApplication, QSettings, QStandardPaths
+
+    QStandardPaths.setTestModeEnabled(True)
+    QCoreApplication.setOrganizationName("lsys-editor-tests")
+    QCoreApplication.setApplicationName("lsys-editor-tests")
+    base = tmp_path_factory.mktemp("qsettings")
+    QSettings.setDefaultFormat(QSettings.Format.IniFormat)
+    QSettings.setPath(QSettings.Format.IniFormat, QSettings.Scope.UserScope, str(base))
+
+
+@pytest.fixture
+def corpus():
+    """Return a function giving the path of a corpus SVG, skipping the test if it is absent."""
+
+    def get(name: str) -> Path:
+        path = CORPUS / name
+        if not path.is_file():
+            pytest.skip(f"corpus file {path} not available")
+        return path
+
+    return get
+
+
+@pytest.fixture
+def helix_lsys(tmp_path) -> Path:
+    """Write the paper's helix grammar to an .lsys file."""
+    path = tmp_path / "helix.lsys"
+    path.write_text(HELIX_LSYS, encoding="utf-8")
+    return path
+
+
+@pytest.fixture
+def window(qtbot, tmp_path):
+    """A main window with its own settings file, no autosave; checks that no worker survives it."""
+    from PySide6.QtCore import QSettings
+
+    from app.main_window import MainWindow
+
+    before = set(threading.enumerate())
+    settings = QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat)
+    win = MainWindow(settings, restore_layout=False, autosave=False)
+    qtbot.addWidget(win)
+    win.resize(1200, 800)
+    win.show()
+    yield win
+    win.doc.undo_stack.setClean()
+    win.close()
+    win.shutdown()
+    left = [t for t in threading.enumerate() if t not in before and t.is_alive() and t.name.startswith("lsys-")]
+    assert not left, f"worker threads still running after close: {left}"
+
+
+def wait_idle(qtbot, win, timeout: int = 20000) -> None:
+    """Wait until inference, derivation and rendering have finished."""
+    qtbot.waitUntil(win.is_idle, timeout=timeout)
