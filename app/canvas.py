@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, QSize, Qt, QTimer, Signal
-from PySide6.QtGui import QColor, QImage, QPainter, QPen, QTransform
+from PySide6.QtGui import QColor, QImage, QPainter, QTransform
 from PySide6.QtWidgets import QSizePolicy, QWidget
 
 from . import core
@@ -32,6 +32,7 @@ from .workers import LatestRunner
 __all__ = ["Canvas", "Frame", "RenderRequest", "View", "recolor"]
 
 SETTLE_MS = 120  # quiet time after pan/zoom before rendering at full quality
+BACKGROUND = (255, 255, 255, 255)
 MIN_ZOOM, MAX_ZOOM = 1e-4, 1e4
 #: Colours cycled for the colour-by-group / colour-by-rule modes.
 PALETTE = (
@@ -77,7 +78,7 @@ class View:
 
 @dataclass(frozen=True)
 class RenderRequest:
-    """One frame to render: immutable inputs only (plus the surface to draw into)."""
+    """One frame to render: immutable inputs, plus the surface to draw into (set when it starts)."""
 
     drawing: Any
     view: View
@@ -85,10 +86,11 @@ class RenderRequest:
     height: int
     dpr: float
     draft: bool
-    renderer: Any
-    slot: int
+    highlight: Any = None  # bool mask of instances drawn in the highlight colour
     overlay: Any = None  # a QSvgRenderer of the input, painted translucently on top
     overlay_rect: QRectF | None = None
+    renderer: Any = None
+    slot: int = 0
 
 
 @dataclass(frozen=True)
@@ -112,8 +114,11 @@ def render_frame(req: RenderRequest, cancel, progress) -> Frame:
     """Render ``req`` on a worker: skia draws into the request's surface, wrapped zero-copy."""
     t0 = time.perf_counter()
     s = req.dpr
-    view = (req.view.zoom * s, 0.0, req.view.ox * s, 0.0, req.view.zoom * s, req.view.oy * s)
-    pixels = req.renderer.draw(req.drawing, view, antialias=not req.draft, draft=req.draft)
+    z = req.view.zoom
+    region = (-req.view.ox / z, -req.view.oy / z, req.width / (z * s), req.height / (z * s))
+    pixels = req.renderer.draw(
+        req.drawing, region, not req.draft, req.draft, background=BACKGROUND, highlight=req.highlight
+    )
     cancel.check()
     h, w = pixels.shape[:2]
     image = QImage(pixels.data, w, h, pixels.strides[0], core.RENDER_FORMAT)
@@ -187,14 +192,15 @@ class Canvas(QWidget):
     -------
     elementClicked(index)
         Instance index under a click (-1: none).
-    idleChanged(idle)
-        Whether the frame on screen is final (full quality, current drawing and view).
+    idleChanged()
+        :meth:`is_idle` may have changed (whether the frame on screen is final: full quality,
+        current drawing and view).
     message(text)
         A rendering error for the user.
     """
 
     elementClicked = Signal(int)
-    idleChanged = Signal(bool)
+    idleChanged = Signal()
     message = Signal(str)
 
     def __init__(self, parent: QWidget | None = None) -> None:
@@ -211,10 +217,9 @@ class Canvas(QWidget):
         self._overlay_rect: QRectF | None = None
         self._shown: Any = None  # the drawing as rendered (recoloured)
         self._frame: Frame | None = None
-        self._renderers: dict[tuple[int, int, int], Any] = {}
+        self._renderers: dict[int, Any] = {}
         self._fit_pending = True
         self._user_moved = False
-        self._selected = -1
         self._centers: np.ndarray | None = None
         self._drag_start: QPointF | None = None
         self._drag_view: View | None = None
@@ -224,7 +229,11 @@ class Canvas(QWidget):
         self._interactive_source: Callable[[], bool] = lambda: False
         self._idle = True
         self.last_frame_seconds = 0.0
-        self.runner = LatestRunner(render_frame, name="lsys-render", parent=self)
+        self._highlight: np.ndarray | None = None
+        self._highlight_rule: int | None = None
+        self.runner = LatestRunner(
+            render_frame, name="lsys-render", prepare=self._assign_surface, parent=self
+        )
         self.runner.resultReady.connect(self._on_frame)
         self.runner.failed.connect(self._on_render_failed)
         self._settle = QTimer(self)
@@ -246,11 +255,21 @@ class Canvas(QWidget):
         self.drawing = drawing
         self._shown = recolor(drawing, self.color_mode)
         self._centers = None
-        self._selected = -1
+        self._update_highlight()
         if self._fit_pending and drawing is not None and len(drawing):
             self._fit_pending = False
             self.fit(render=False)
         self.request_render()
+
+    def set_highlight_rule(self, rule: int | None) -> None:
+        """Draw the instances emitted by rule index ``rule`` (-1: the axiom) in the highlight colour."""
+        self._highlight_rule = rule
+        self._update_highlight()
+        self.request_render()
+
+    def _update_highlight(self) -> None:
+        d, r = self.drawing, self._highlight_rule
+        self._highlight = None if d is None or r is None or len(d) == 0 else np.asarray(d.rule) == r
 
     def fit_on_next_drawing(self) -> None:
         """Fit the view to the next drawing shown (a new file)."""
@@ -357,20 +376,23 @@ class Canvas(QWidget):
             return
         dpr = float(self.devicePixelRatioF())
         w, h = max(1, round(self.width() * dpr)), max(1, round(self.height() * dpr))
-        slot = 1 - self._frame.slot if self._frame is not None else 0
-        key = (w, h, slot)
-        renderer = self._renderers.get(key)
-        if renderer is None:
-            for k in [k for k in self._renderers if k[2] == slot]:
-                del self._renderers[k]
-            renderer = self._renderers[key] = core.make_renderer(w, h)
         overlay = self._overlay if self.overlay_visible else None
         self.runner.submit(
             RenderRequest(
-                self._shown, self.view, w, h, dpr, draft, renderer, slot, overlay, self._overlay_rect
+                self._shown, self.view, w, h, dpr, draft, self._highlight, overlay, self._overlay_rect
             )
         )
         self.update()
+
+    def _assign_surface(self, req: RenderRequest) -> RenderRequest:
+        """Give a starting job the surface that is not on screen (double buffering)."""
+        slot = 1 - self._frame.slot if self._frame is not None else 0
+        renderer = self._renderers.get(slot)
+        if renderer is None:
+            renderer = self._renderers[slot] = core.make_renderer(req.width, req.height)
+        elif renderer.size != (req.width, req.height):
+            renderer.resize(req.width, req.height)
+        return dataclasses.replace(req, renderer=renderer, slot=slot)
 
     def request_full_quality(self) -> None:
         """Render at full quality now (a gesture ended)."""
@@ -424,7 +446,7 @@ class Canvas(QWidget):
     def _set_idle(self, idle: bool) -> None:
         if idle != self._idle:
             self._idle = idle
-            self.idleChanged.emit(idle)
+            self.idleChanged.emit()
 
     # -- Qt events ------------------------------------------------------------------------------------
     def paintEvent(self, event) -> None:
@@ -442,14 +464,6 @@ class Canvas(QWidget):
                     QTransform(s, 0, 0, s, self.view.ox - f.view.ox * s, self.view.oy - f.view.oy * s)
                 )
                 painter.drawImage(QPointF(0, 0), f.image)
-                painter.resetTransform()
-        if self._selected >= 0 and self._centers is not None and self._selected < len(self._centers):
-            c = self._centers[self._selected]
-            x, y = self.view.to_widget(c.real, c.imag)
-            r = max(6.0, core.instance_radius(self.drawing, self._selected) * self.view.zoom)
-            painter.setRenderHint(QPainter.RenderHint.Antialiasing)
-            painter.setPen(QPen(QColor("#d50000"), 2))
-            painter.drawEllipse(QPointF(x, y), r, r)
         painter.end()
 
     def resizeEvent(self, event) -> None:
@@ -506,9 +520,7 @@ class Canvas(QWidget):
     def mouseReleaseEvent(self, event) -> None:
         """A release without movement is a click: pick the element under it."""
         if self._press_pos is not None and event.button() == Qt.MouseButton.LeftButton and not self._space:
-            self._selected = self.pick(event.position())
-            self.update()
-            self.elementClicked.emit(self._selected)
+            self.elementClicked.emit(self.pick(event.position()))
         self._drag_start = self._drag_view = self._press_pos = None
         if not self._space:
             self.unsetCursor()

@@ -114,7 +114,7 @@ class Document(QObject):
         Inference runs in the background; ``inferenceFinished`` also follows failures.
     message(text)
         A readable error or note for the user.
-    pathChanged(), busyChanged(busy), gestureFinished()
+    pathChanged(), busyChanged() (see :attr:`busy`), gestureFinished()
     """
 
     sceneChanged = Signal()
@@ -129,7 +129,7 @@ class Document(QObject):
     inferenceFinished = Signal()
     message = Signal(str)
     pathChanged = Signal()
-    busyChanged = Signal(bool)
+    busyChanged = Signal()
     gestureFinished = Signal()
 
     def __init__(self, parent: QObject | None = None, *, infer_compute=None) -> None:
@@ -431,8 +431,8 @@ class Document(QObject):
         self.request_derive()
 
     # -- worker results --------------------------------------------------------------------------------
-    def _emit_busy(self, _busy: bool = False) -> None:
-        self.busyChanged.emit(self.busy)
+    def _emit_busy(self) -> None:
+        self.busyChanged.emit()
 
     def _on_inferred(self, out: InferOutcome) -> None:
         purpose, data = self._infer_purpose

@@ -154,6 +154,9 @@ class InferencePanel(QWidget):
 
     def set_progress(self, stage: str, fraction: float) -> None:
         """Show the progress of one stage (a bar is added the first time a stage reports)."""
+        if stage == "done":
+            self.status.setText("Finishing…")
+            return
         bar = self.bars.get(stage)
         if bar is None:
             bar = QProgressBar(self._progress_box)

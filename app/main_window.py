@@ -323,6 +323,8 @@ class MainWindow(QMainWindow):
 
     def _on_scene_changed(self) -> None:
         self.canvas.set_overlay_svg(self.doc.scene_path)
+        self.canvas.set_highlight_rule(None)
+        self.rules_panel.highlight_rule(None)
         if self.doc.scene_path:
             self.add_recent(self.doc.scene_path)
             self.canvas.fit_on_next_drawing()
@@ -332,16 +334,19 @@ class MainWindow(QMainWindow):
 
     def _on_inference_finished(self) -> None:
         self.inference_panel.set_running(False)
+        self.statusBar().clearMessage()
         self._update_status()
 
     def _on_element_clicked(self, index: int) -> None:
         drawing, grammar = self.doc.drawing, self.doc.grammar
         if drawing is None or grammar is None or index < 0:
             self.rules_panel.highlight_rule(None)
+            self.canvas.set_highlight_rule(None)
             return
         rule = int(drawing.rule[index])
         name = "axiom" if rule < 0 or rule >= len(grammar.rules) else grammar.rules[rule].name
         self.rules_panel.highlight_rule(name)
+        self.canvas.set_highlight_rule(rule)
         self.statusBar().showMessage(f"element {index} drawn by {name}", 5000)
 
     def _update_actions(self, *_args: Any) -> None:

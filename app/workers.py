@@ -79,6 +79,9 @@ class LatestRunner(QObject):
         Delay before a submitted request starts; every new request restarts the delay.
     name : str
         Name of the worker threads (for logs and debuggers).
+    prepare : callable, optional
+        ``prepare(request) -> request``, called on the UI thread just before a job starts, to
+        complete the snapshot with resources that depend on what is on screen at that moment.
 
     Signals
     -------
@@ -90,21 +93,28 @@ class LatestRunner(QObject):
         The newest request's result, on the UI thread.
     failed(message)
         The newest request failed; ``message`` is one readable line.
-    busyChanged(busy)
-        Whether a request is waiting or running.
+    busyChanged()
+        :attr:`busy` changed.
     """
 
     started = Signal()
     progress = Signal(str, float)
     resultReady = Signal(object)
     failed = Signal(str)
-    busyChanged = Signal(bool)
+    busyChanged = Signal()
 
     def __init__(
-        self, compute: Compute, *, debounce_ms: int = 0, name: str = "worker", parent: QObject | None = None
+        self,
+        compute: Compute,
+        *,
+        debounce_ms: int = 0,
+        name: str = "worker",
+        prepare: Callable[[Any], Any] | None = None,
+        parent: QObject | None = None,
     ) -> None:
         super().__init__(parent)
         self._compute = compute
+        self._prepare = prepare
         self._name = name
         self._generation = 0
         self._pending: tuple[int, Any] | None = None
@@ -180,7 +190,7 @@ class LatestRunner(QObject):
         busy = self.busy
         if busy != self._busy:
             self._busy = busy
-            self.busyChanged.emit(busy)
+            self.busyChanged.emit()
 
     def _start_pending(self) -> None:
         if self._running is not None or self._pending is None or self._closed:
@@ -189,6 +199,8 @@ class LatestRunner(QObject):
             return
         generation, request = self._pending
         self._pending = None
+        if self._prepare is not None:
+            request = self._prepare(request)
         signals = _JobSignals()
         queued = Qt.ConnectionType.QueuedConnection
         signals.progress.connect(self._on_progress, queued)

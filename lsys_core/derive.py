@@ -292,7 +292,7 @@ def derive(
         b = np.concatenate([x[2] for x in batches])
         work += m.size
         if m.size > limit or work > work_budget:
-            raise LimitError(f"derivation exceeds its limit ({limit:,} elements) in {where}")
+            raise LimitError(f"derivation exceeds the element limit ({limit:,} elements) in {where}")
         masks = _case_masks(rule.cases, m) if rule.parametric else [np.ones(m.size, bool)] + [
             np.zeros(m.size, bool)] * (len(rule.cases) - 1)
         for ci, case in enumerate(compiled[r]):
@@ -343,7 +343,10 @@ def _unroll(interp, emit, push, rule, r, ci, case, m, a, b, where, budget) -> No
         lengths = lengths + ((m - lengths * c) == 0)
     total = int(lengths.sum())
     if total > budget:
-        raise LimitError(f"derivation exceeds its limit in {where}: {total:,} repetitions requested")
+        raise LimitError(
+            f"derivation exceeds the element limit in {where}: {total:,} repetitions requested; "
+            "lower its counter m or raise the limit"
+        )
     draws_per_step = sum(1 for op in case.ops if op[0] == "draw")
     interp.emitter.reserve(total * draws_per_step, where)
     starts = np.concatenate(([0], np.cumsum(lengths)[:-1])).astype(np.int64)

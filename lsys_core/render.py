@@ -34,6 +34,8 @@ __all__ = ["Renderer", "fit_view", "parse_style", "render", "render_png"]
 HIGHLIGHT = (255, 111, 0, 255)
 #: In draft mode, strokes thinner than this many pixels are drawn as hairlines.
 DRAFT_HAIRLINE = 2.0
+#: Most terminals (path, style) whose skia objects a renderer keeps.
+CACHE_SIZE = 4096
 #: Largest image side accepted, in pixels.
 MAX_SIDE = 16384
 
@@ -76,7 +78,7 @@ def _rgba(color: str, opacity: float) -> tuple[int, int, int, int] | None:
     if col.value is None:
         return None
     alpha = col.alpha * max(0.0, min(1.0, opacity))
-    return (col.red, col.green, col.blue, int(round(alpha)))
+    return (col.red, col.green, col.blue, round(alpha))
 
 
 @dataclass
@@ -126,7 +128,9 @@ def _skia_paint(rgba, antialias: bool, stroke: _Paints | None = None, width: flo
     paint.setStyle(skia.Paint.kStroke_Style)
     paint.setStrokeWidth(width)
     paint.setStrokeCap(
-        {"round": skia.Paint.kRound_Cap, "square": skia.Paint.kSquare_Cap}.get(stroke.cap, skia.Paint.kButt_Cap)
+        {"round": skia.Paint.kRound_Cap, "square": skia.Paint.kSquare_Cap}.get(
+            stroke.cap, skia.Paint.kButt_Cap
+        )
     )
     paint.setStrokeJoin(
         {"round": skia.Paint.kRound_Join, "bevel": skia.Paint.kBevel_Join}.get(
@@ -316,6 +320,8 @@ class Renderer:
         key = (path, style)
         entry = self._cache.get(key)
         if entry is None:
+            if len(self._cache) >= CACHE_SIZE:
+                self._cache.clear()  # edits create new terminals: keep the cache bounded
             geometry = _geometry(path)
             paints = _paints(style)
             skpath = _path_from_arrays(geometry.points, geometry.verbs, paints.evenodd)
@@ -383,11 +389,12 @@ class Renderer:
             self._draw_each(terms, symbol, da, db, visible, antialias)
         if highlight is not None:
             mask = np.zeros(n, dtype=bool)
-            hl = np.asarray(highlight)
+            hl = np.asarray(highlight).reshape(-1)
             if hl.dtype == bool:
-                mask[: hl.size] = hl.reshape(-1)[:n]
+                mask[: min(n, hl.size)] = hl[:n]
             else:
-                mask[hl.astype(np.intp)] = True
+                hl = hl.astype(np.intp)
+                mask[hl[(hl >= 0) & (hl < n)]] = True
             self._draw_highlight(terms, symbol, da, db, visible & mask, antialias and not draft)
         canvas.resetMatrix()
         return self._pixels
@@ -398,11 +405,13 @@ class Renderer:
         radius = np.array(
             [t.geometry.radius + (t.paints.width / 2 if t.paints.stroke else 0.0) for t in terms] + [0.0]
         )
-        rr = radius[np.where(symbol < len(terms), symbol, len(terms))] * np.abs(da) + 1.0
-        x, y = db.real, db.imag
-        ok = (x + rr >= 0) & (x - rr <= width) & (y + rr >= 0) & (y - rr <= height)
         empty = np.array([t.geometry.verbs.size == 0 for t in terms] + [True])
-        return ok & ~empty[np.where(symbol < len(terms), symbol, len(terms))] & np.isfinite(rr)
+        sym = np.where((symbol >= 0) & (symbol < len(terms)), symbol, len(terms))  # bad index: not drawn
+        rr = radius[sym] * np.abs(da) + 1.0
+        x, y = db.real, db.imag
+        with np.errstate(invalid="ignore"):
+            ok = (x + rr >= 0) & (x - rr <= width) & (y + rr >= 0) & (y - rr <= height)
+        return ok & ~empty[sym] & np.isfinite(rr) & np.isfinite(db)
 
     def _draw_each(self, terms, symbol, da, db, visible, antialias: bool) -> None:
         """Draw every visible instance with its own matrix, in order."""
@@ -471,7 +480,9 @@ class Renderer:
             path = self._batch_path(term.geometry, da[sel], db[sel], term.paints.evenodd)
             if term.paints.fill is not None:
                 canvas.drawPath(path, _skia_paint((r, g, b, a // 2), antialias))
-            outline = _skia_paint((r, g, b, a), antialias, _Paints(None, None, 1.5, "round", "round", 4.0, False), 1.5)
+            outline = _skia_paint(
+                (r, g, b, a), antialias, _Paints(None, None, 1.5, "round", "round", 4.0, False), 1.5
+            )
             canvas.drawPath(path, outline)
 
 

@@ -32,7 +32,7 @@ __all__ = ["detect_similarity", "format_cubics", "symmetry_order", "terminal_nam
 
 #: Samples per element for voting, ICP and φ; the representative gets ``_DENSE`` times more.
 _SAMPLES = 96
-_DENSE = 8
+_DENSE = 9
 _CHUNK = 1024
 _STAGE = "similarity"
 
@@ -181,7 +181,8 @@ class _Rep:
     """A representative: its element index, local origin, dense samples and references."""
 
     def __init__(self, element: Element, index: int, coarse: Samples):
-        dense_frac = ((np.arange(_SAMPLES * _DENSE) + _DENSE / 2) / (_SAMPLES * _DENSE)) % 1.0
+        # (k + 0.5) / m with an odd factor: unbiased, and the coarse samples are among them
+        dense_frac = arc_fractions(_SAMPLES * _DENSE)
         dense = sample_elements([element], dense_frac)
         self.index = index
         self.origin = complex(dense.points[0].mean())
@@ -197,6 +198,11 @@ class _Rep:
             self.dense,
             self.dense_normals,
             float(dense.length[0]) * inv,
+            0.5,
+            len(element.closed) == 1 and not element.closed[0],
+            (np.asarray(element.cubics, dtype=complex).reshape(-1, 4) - self.origin) * inv,
+            dense.segment[0],
+            dense.param[0],
         )
         self.control = np.asarray(element.cubics, dtype=complex).ravel()
         self.orders = variants(element)

@@ -18,6 +18,8 @@ import numpy as np
 from scipy.ndimage import uniform_filter1d
 from scipy.spatial import cKDTree
 
+from .similarity_sampling import bezier
+
 __all__ = ["PERFECT", "Batch", "MatchResult", "Reference", "match_batch"]
 
 #: A fit gap (RMS point-to-line distance, in RMS radii) below which a match is taken as exact.
@@ -38,6 +40,7 @@ _COARSE_STRIDE = 3
 _COARSE_ITERS = 6
 _FINE_ITERS = 5
 _COARSE_MARGIN = 0.2
+_ARC_AGREE = 0.1
 _CONVERGED = 1e-9
 
 
@@ -59,15 +62,33 @@ class Reference:
     order: np.ndarray
     radius_sorted: np.ndarray
     dense_step: float
+    dense_frac: np.ndarray
+    dense_frac_start: float
+    open_path: bool
+    cubics: np.ndarray
+    dense_seg: np.ndarray
+    dense_t: np.ndarray
 
     @classmethod
-    def build(cls, points, normals, curvature, dense, dense_normals, length: float) -> Reference:
-        """Build a reference from normalised coarse and dense samples and its normalised length."""
+    def build(
+        cls, points, normals, curvature, dense, dense_normals, length: float, start: float, open_path: bool,
+        cubics: np.ndarray, dense_seg: np.ndarray, dense_t: np.ndarray,
+    ) -> Reference:
+        """Build a reference from normalised samples, its normalised length and the dense offset.
+
+        The dense sample ``k`` lies at the arc-length fraction ``((k + start) / m) % 1``, on
+        cubic ``dense_seg[k]`` of the normalised ``cubics`` at parameter ``dense_t[k]``;
+        ``open_path`` says whether the shape is a single open subpath.
+        """
         rho = np.abs(points)
         order = np.argsort(rho, kind="stable")
         tree = cKDTree(np.column_stack([dense.real, dense.imag]))
-        step = length / dense.size
-        return cls(points, normals, curvature, dense, dense_normals, tree, order, rho[order], step)
+        m = dense.size
+        frac = ((np.arange(m) + start) / m) % 1.0
+        return cls(
+            points, normals, curvature, dense, dense_normals, tree, order, rho[order], length / m, frac, start,
+            open_path, cubics, dense_seg, dense_t,
+        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -178,43 +199,92 @@ class _VoteSpace:
         return rot0, t0, valid
 
 
-def _nearest(ref: Reference, x: np.ndarray):
-    """Return distances, indices and whether found (within ``_FAR``), of the nearest dense samples."""
+def _nearest(ref: Reference, x: np.ndarray, exact: bool = False):
+    """Return the nearest points of the representative to points ``x``.
+
+    Returns distance, dense sample index, whether found (within ``_FAR``), and the nearest
+    point and unit normal there: the dense sample's, or with ``exact`` the foot point on
+    the curve itself, found by Newton steps from the dense sample (point-to-line residuals
+    at foot points vanish for an exact copy, however it was sampled).
+    """
     pts = np.column_stack([x.real.ravel(), x.imag.ravel()])
     dist, nn = ref.tree.query(pts, distance_upper_bound=_FAR, workers=-1 if pts.shape[0] > 20000 else 1)
-    found = np.isfinite(dist)
-    nn = np.minimum(nn, ref.dense.size - 1)
-    return dist.reshape(x.shape), nn.reshape(x.shape), found.reshape(x.shape)
+    found = np.isfinite(dist).reshape(x.shape)
+    nn = np.minimum(nn, ref.dense.size - 1).reshape(x.shape)
+    dist = dist.reshape(x.shape)
+    if not exact:
+        return dist, nn, found, ref.dense[nn], ref.dense_normals[nn]
+    c = ref.cubics[ref.dense_seg[nn]]
+    t = ref.dense_t[nn]
+    for _ in range(2):
+        pos, d1, d2 = bezier(c, t)
+        diff = pos - x
+        g = (diff * np.conj(d1)).real
+        h = np.abs(d1) ** 2 + (diff * np.conj(d2)).real
+        h = np.where(h > 1e-12, h, np.maximum(np.abs(d1) ** 2, 1e-12))
+        t = np.clip(t - g / h, 0.0, 1.0)
+    foot, d1, _ = bezier(c, t)
+    speed = np.abs(d1)
+    normal = np.where(speed > 1e-9, 1j * d1 / np.maximum(speed, 1e-300), ref.dense_normals[nn])
+    return np.where(found, np.abs(x - foot), dist), nn, found, foot, normal
 
 
-def _icp(ref: Reference, q: np.ndarray, qn: np.ndarray, c: np.ndarray, d: np.ndarray, iters: int):
+def _arc_targets(ref: Reference, nn: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Return point-to-point targets that follow arc length instead of nearest points.
+
+    Nearest points slide along an open outline with the candidate, so they cannot pin
+    down the poses that only the ends of an arc or a line determine.  Arc length can: on
+    a single open path the candidate sample at fraction ``u`` corresponds to fraction
+    ``u`` (or ``1 - u`` when drawn the other way) of the representative.  The direction is
+    the one most nearest points agree with; samples far from their arc-length partner
+    (another shape, another subpath layout) keep their nearest point.
+    """
+    v = ref.dense_frac[nn]
+    fwd = np.abs(v - u) <= _ARC_AGREE
+    bwd = np.abs(v - (1.0 - u)) <= _ARC_AGREE
+    forward = fwd.sum(axis=1) >= bwd.sum(axis=1)
+    w = np.where(forward[:, None], u, 1.0 - u)
+    agree = np.where(forward[:, None], fwd, bwd)
+    m = ref.dense.size
+    pos = w * m - ref.dense_frac_start
+    k0 = np.floor(pos).astype(np.int64)
+    t = pos - k0
+    lo, hi = np.clip(k0, 0, m - 1), np.clip(k0 + 1, 0, m - 1)
+    interp = ref.dense[lo] * (1 - t) + ref.dense[hi] * t
+    return np.where(agree, interp, ref.dense[nn])
+
+
+def _icp(ref: Reference, q, qn, c, d, iters: int, u=None, exact: bool = False):
     """Refine ``rep ≈ c * q + d`` for every candidate by trimmed point-to-line ICP.
 
     Each step solves the 4-unknown linear least squares of the point-to-line distances
     (plus a small point-to-point term that keeps it well posed on circles and lines) in
-    closed form for all candidates at once.
+    closed form for all candidates at once.  With the candidates' arc-length fractions
+    ``u`` the point-to-point term follows arc length (:func:`_arc_targets`), which pins
+    down open arcs and lines exactly; ``exact`` uses foot points on the curve.
 
     Returns
     -------
     c, d : ndarray of complex
         The refined maps.
-    dist, nn, found : ndarray, shape (b, s)
-        Nearest dense samples of the mapped candidate samples under the refined maps.
+    near : tuple of ndarray, shape (b, s) each
+        ``(dist, nn, found, foot, normal)`` of :func:`_nearest` under the refined maps.
     """
     b, s = q.shape
     active = np.ones(b, bool)
-    dist = np.zeros((b, s))
-    nn = np.zeros((b, s), np.int64)
-    found = np.zeros((b, s), bool)
+    near = (np.zeros((b, s)), np.zeros((b, s), np.int64), np.zeros((b, s), bool),
+            np.zeros((b, s), complex), np.ones((b, s), complex))
     lam = _P2P_WEIGHT
     for _ in range(iters):
         idx = np.flatnonzero(active)
         if idx.size == 0:
             break
         qa, na = q[idx], qn[idx]
-        di, ni, fi = _nearest(ref, c[idx, None] * qa + d[idx, None])
-        dist[idx], nn[idx], found[idx] = di, ni, fi
-        r, n = ref.dense[ni], ref.dense_normals[ni]
+        res = _nearest(ref, c[idx, None] * qa + d[idx, None], exact)
+        for full, part in zip(near, res, strict=True):
+            full[idx] = part
+        di, ni, fi, r, n = res
+        rp = r if u is None else _arc_targets(ref, ni, u)
         rot = c[idx] / np.maximum(np.abs(c[idx]), 1e-300)
         compat = np.abs((rot[:, None] * na * np.conj(n)).real) > _NORMAL_COS
         tau = np.maximum(3.0 * np.median(np.where(fi, di, _FAR), axis=1), _INLIER)
@@ -230,7 +300,7 @@ def _icp(ref: Reference, q: np.ndarray, qn: np.ndarray, c: np.ndarray, d: np.nda
             ],
             axis=1,
         )
-        tgt = np.concatenate([(r * np.conj(n)).real, lam * r.real, lam * r.imag], axis=1)
+        tgt = np.concatenate([(r * np.conj(n)).real, lam * rp.real, lam * rp.imag], axis=1)
         wj = (jac * np.tile(w, 3)[..., None]).transpose(0, 2, 1)
         a_mat = wj @ jac + np.eye(4) * 1e-12
         with np.errstate(all="ignore"):
@@ -244,11 +314,13 @@ def _icp(ref: Reference, q: np.ndarray, qn: np.ndarray, c: np.ndarray, d: np.nda
         active[idx] = ok & (change > _CONVERGED)
     idx = np.flatnonzero(active)
     if idx.size:
-        dist[idx], nn[idx], found[idx] = _nearest(ref, c[idx, None] * q[idx] + d[idx, None])
-    return c, d, dist, nn, found
+        res = _nearest(ref, c[idx, None] * q[idx] + d[idx, None], exact)
+        for full, part in zip(near, res, strict=True):
+            full[idx] = part
+    return c, d, near
 
 
-def _score(ref: Reference, q, qn, c, d, dist, nn, found, perimeter):
+def _score(ref: Reference, q, qn, c, d, near, perimeter):
     """Return ``φ`` (the smaller share of either shape's samples lying on the other) and the fit gap.
 
     The forward share counts candidate samples within ``_INLIER`` of the representative
@@ -256,13 +328,13 @@ def _score(ref: Reference, q, qn, c, d, dist, nn, found, perimeter):
     samples that lie, along its outline, within reach of a matched candidate sample.
     The gap is the RMS point-to-line distance of the matched samples (``_FAR`` if none).
     """
+    dist, nn, found, foot, n = near
     b, s = q.shape
     rot = c / np.maximum(np.abs(c), 1e-300)
-    n = ref.dense_normals[nn]
     compat = np.abs((rot[:, None] * qn * np.conj(n)).real) > _NORMAL_COS
     inl = found & (dist < _INLIER) & compat
     forward = inl.mean(axis=1)
-    line = ((c[:, None] * q + d[:, None] - ref.dense[nn]) * np.conj(n)).real
+    line = ((c[:, None] * q + d[:, None] - foot) * np.conj(n)).real
     cnt = inl.sum(axis=1)
     gap = np.where(cnt > 0, np.sqrt(np.sum(np.where(inl, line * line, 0.0), axis=1) / np.maximum(cnt, 1)), _FAR)
     m = ref.dense.size
@@ -328,8 +400,8 @@ def match_batch(
             if rows.size == 0:
                 break
         c0 = np.conj(r0)
-        c, d, dist, nn, found = _icp(ref, qs[rows], ns[rows], c0, -c0 * t0, _COARSE_ITERS)
-        sc, gap = _score(ref, qs[rows], ns[rows], c, d, dist, nn, found, perimeter[rows] * _COARSE_STRIDE)
+        c, d, near = _icp(ref, qs[rows], ns[rows], c0, -c0 * t0, _COARSE_ITERS)
+        sc, gap = _score(ref, qs[rows], ns[rows], c, d, near, perimeter[rows] * _COARSE_STRIDE)
         k = sc - 2.0 * gap
         better = k > key[rows]
         sel = rows[better]
@@ -339,9 +411,8 @@ def match_batch(
     phi, gap = best.copy(), gap1
     fine = np.flatnonzero(best >= threshold - _COARSE_MARGIN)
     if fine.size:
-        c2, d2, dist, nn, found = _icp(ref, batch.points[fine], batch.normals[fine], c1[fine], d1[fine], _FINE_ITERS)
-        phi[fine], gap[fine] = _score(
-            ref, batch.points[fine], batch.normals[fine], c2, d2, dist, nn, found, perimeter[fine]
-        )
+        u = (np.arange(batch.points.shape[1]) + 0.5) / batch.points.shape[1] if ref.open_path else None
+        c2, d2, near = _icp(ref, batch.points[fine], batch.normals[fine], c1[fine], d1[fine], _FINE_ITERS, u, True)
+        phi[fine], gap[fine] = _score(ref, batch.points[fine], batch.normals[fine], c2, d2, near, perimeter[fine])
         c1[fine], d1[fine] = c2, d2
     return MatchResult(phi, gap, c1, d1)

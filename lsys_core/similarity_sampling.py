@@ -13,10 +13,13 @@ import numpy as np
 
 from .model import Element
 
-__all__ = ["Samples", "arc_fractions", "element_features", "sample_elements"]
+__all__ = ["Samples", "arc_fractions", "bezier", "element_features", "sample_elements"]
 
-#: Chords per cubic used to tabulate arc length (the arc-length inverse is linear in between).
-_TABLE = 16
+#: Sub-intervals per cubic of the arc-length table; each is integrated by Gauss–Legendre.
+_TABLE = 8
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(4)
+_GL_X = (_GL_X + 1.0) / 2.0
+_GL_W = _GL_W / 2.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -33,12 +36,16 @@ class Samples:
         Unsigned curvature ``|κ|`` at the samples.
     length : ndarray of float, shape (n,)
         Total arc length of every element.
+    segment, param : ndarray, shape (n, s)
+        Index of the element's cubic each sample lies on, and the curve parameter there.
     """
 
     points: np.ndarray
     normals: np.ndarray
     curvature: np.ndarray
     length: np.ndarray
+    segment: np.ndarray
+    param: np.ndarray
 
 
 def arc_fractions(count: int, offset: float = 0.5) -> np.ndarray:
@@ -56,7 +63,7 @@ def _stack(elements: list[Element] | tuple[Element, ...]) -> tuple[np.ndarray, n
     return cubics, owner
 
 
-def _bezier(c: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def bezier(c: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Evaluate cubics ``c`` (…, 4) at ``t`` (…): position, first and second derivative."""
     p0, p1, p2, p3 = c[..., 0], c[..., 1], c[..., 2], c[..., 3]
     s = 1.0 - t
@@ -64,6 +71,20 @@ def _bezier(c: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
     d1 = 3 * (s * s * (p1 - p0) + 2 * s * t * (p2 - p1) + t * t * (p3 - p2))
     d2 = 6 * (s * (p2 - 2 * p1 + p0) + t * (p3 - 2 * p2 + p1))
     return pos, d1, d2
+
+
+def _speed(c: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Return ``|B'(t)|`` of cubics ``c`` (…, 4) at ``t`` (…)."""
+    p0, p1, p2, p3 = c[..., 0], c[..., 1], c[..., 2], c[..., 3]
+    s = 1.0 - t
+    return np.abs(3 * (s * s * (p1 - p0) + 2 * s * t * (p2 - p1) + t * t * (p3 - p2)))
+
+
+def _partial_length(c: np.ndarray, t0: np.ndarray, t1: np.ndarray) -> np.ndarray:
+    """Return the arc length of cubics ``c`` (…, 4) between ``t0`` and ``t1`` (Gauss–Legendre)."""
+    h = t1 - t0
+    tt = t0[..., None] + h[..., None] * _GL_X
+    return h * np.sum(_GL_W * _speed(c[..., None, :], tt), axis=-1)
 
 
 def sample_elements(elements: list[Element] | tuple[Element, ...], fractions: np.ndarray) -> Samples:
@@ -89,10 +110,13 @@ def sample_elements(elements: list[Element] | tuple[Element, ...], fractions: np
     curv = np.zeros((n, s))
     length = np.zeros(n)
     if cubics.shape[0] == 0:
-        return Samples(points, normals, curv, length)
-    tt = np.linspace(0.0, 1.0, _TABLE + 1)
-    table, _, _ = _bezier(cubics[:, None, :], tt[None, :])
-    chords = np.abs(np.diff(table, axis=1)).ravel()  # (K * T,)
+        return Samples(points, normals, curv, length, np.zeros((n, s), np.int64), np.zeros((n, s)))
+    knots = np.arange(_TABLE) / _TABLE
+    chords = _partial_length(
+        np.broadcast_to(cubics[:, None, :], (cubics.shape[0], _TABLE, 4)),
+        np.broadcast_to(knots, (cubics.shape[0], _TABLE)),
+        np.broadcast_to(knots + 1.0 / _TABLE, (cubics.shape[0], _TABLE)),
+    ).ravel()  # (K * T,) arc length of every sub-interval
     cum = np.concatenate([[0.0], np.cumsum(chords)])
     chord_owner = np.repeat(owner, _TABLE)
     first = np.searchsorted(chord_owner, np.arange(n), side="left")
@@ -108,8 +132,14 @@ def sample_elements(elements: list[Element] | tuple[Element, ...], fractions: np
     ch = chords[idx]
     frac = np.where(ch > 0, (target - cum[idx]) / np.where(ch > 0, ch, 1.0), 0.0)
     seg = idx // _TABLE
-    t = np.clip(((idx % _TABLE) + np.clip(frac, 0.0, 1.0)) / _TABLE, 0.0, 1.0)
-    pos, d1, d2 = _bezier(cubics[seg], t)
+    t_lo = (idx % _TABLE) / _TABLE
+    t = t_lo + np.clip(frac, 0.0, 1.0) / _TABLE
+    c_seg = cubics[seg]
+    for _ in range(2):  # Newton steps on the arc length within the sub-interval
+        err = cum[idx] + _partial_length(c_seg, t_lo, t) - target
+        sp = _speed(c_seg, t)
+        t = np.clip(t - np.where(sp > 0, err / np.where(sp > 0, sp, 1.0), 0.0), t_lo, t_lo + 1.0 / _TABLE)
+    pos, d1, d2 = bezier(c_seg, t)
     chord_dir = cubics[seg, 3] - cubics[seg, 0]
     scale = np.maximum(np.abs(cubics[seg]).max(axis=-1), 1.0)
     tiny = 1e-12 * scale
@@ -120,7 +150,8 @@ def sample_elements(elements: list[Element] | tuple[Element, ...], fractions: np
     mag = np.abs(tangent)
     normals = np.where(mag > 0, 1j * tangent / np.where(mag > 0, mag, 1.0), 1.0)
     points = np.where(present[:, None], pos, 0.0)
-    return Samples(points, normals, curv, length)
+    local = seg - np.searchsorted(owner, np.arange(n))[:, None]
+    return Samples(points, normals, curv, length, local, t)
 
 
 def element_features(samples: Samples) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

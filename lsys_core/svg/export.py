@@ -37,7 +37,9 @@ def terminal_points(drawing: Drawing) -> list[np.ndarray]:
     """Return the control points of each terminal's path (local frame; empty if it has none)."""
     out = []
     for term in drawing.terminals:
-        cubics, _, _ = cubics_from_d(term.path) if term.path.strip() else (np.zeros((0, 4), complex), None, None)
+        cubics, _, _ = (
+            cubics_from_d(term.path) if term.path.strip() else (np.zeros((0, 4), complex), None, None)
+        )
         out.append(np.unique(cubics.ravel()) if cubics.size else np.zeros(0, dtype=complex))
     return out
 
@@ -45,7 +47,9 @@ def terminal_points(drawing: Drawing) -> list[np.ndarray]:
 def _stroke_half_width(style: str) -> float:
     """Return half the stroke width a style draws with (0 without a stroke)."""
     decl = dict(
-        (k.strip().lower(), v.strip()) for k, _, v in (p.partition(":") for p in style.split(";")) if k.strip()
+        (k.strip().lower(), v.strip())
+        for k, _, v in (p.partition(":") for p in style.split(";"))
+        if k.strip()
     )
     if decl.get("stroke", "none").lower() in ("none", ""):
         return 0.0

@@ -88,10 +88,12 @@ class _Skips:
     counts: dict[str, int] = field(default_factory=dict)
 
     def add(self, reason: str, n: int = 1) -> None:
+        """Count ``n`` more elements skipped for ``reason`` (non-positive ``n`` is ignored)."""
         if n > 0:
             self.counts[reason] = self.counts.get(reason, 0) + n
 
     def messages(self) -> tuple[str, ...]:
+        """Return one ``"skipped N elements: reason"`` line per reason."""
         out = []
         for reason, n in self.counts.items():
             out.append(f"skipped {n} element{'s' if n != 1 else ''}: {reason}")
@@ -204,8 +206,6 @@ def _check_bytes(data: bytes, name: str) -> None:
     utf16 = head.startswith((b"\xff\xfe", b"\xfe\xff"))
     if not utf16 and b"\x00" in head:
         raise SvgError(f"not an SVG: {name} holds binary data")
-    if _INTERNAL_SUBSET.search(data, 0, 65536):
-        raise SvgError(f"DTD internal subsets are not allowed in SVG input (possible XML attack): {name}")
 
 
 def _parse_xml(source: str | bytes, name: str):
@@ -244,8 +244,11 @@ def _prepare(source: str | bytes, max_elements: int, max_depth: int, name: str) 
     """Check the XML tree and re-serialise it for svgelements."""
     import xml.etree.ElementTree as ET
 
-    _check_bytes(source if isinstance(source, bytes) else source.encode("utf-8", "replace"), name)
-    root = _parse_xml(source, name)
+    raw = source if isinstance(source, bytes) else source.encode("utf-8", "replace")
+    _check_bytes(raw, name)
+    root = _parse_xml(source, name)  # rejects entities (billion laughs, XXE) first
+    if _INTERNAL_SUBSET.search(raw, 0, 65536):
+        raise SvgError(f"DTD internal subsets are not allowed in SVG input (possible XML attack): {name}")
     if _local(root.tag) != "svg":
         raise SvgError(f"not an SVG: {name}: the root element is <{root.tag}>, not <svg>")
 
@@ -422,8 +425,18 @@ def _extract(prepared: _Prepared, name: str) -> tuple[list[Element], _Skips]:
         doc = SVG.parse(io.BytesIO(prepared.data), reify=False, parse_display_none=True)
     except RecursionError as exc:
         raise LimitError(f"{name}: the SVG is nested too deeply to read") from exc
-    except (ValueError, TypeError, IndexError, KeyError, AttributeError, ZeroDivisionError, OverflowError) as exc:
-        raise SvgError(f"cannot read SVG {name}: invalid attribute value ({type(exc).__name__}: {exc})") from exc
+    except (
+        ValueError,
+        TypeError,
+        IndexError,
+        KeyError,
+        AttributeError,
+        ZeroDivisionError,
+        OverflowError,
+    ) as exc:
+        raise SvgError(
+            f"cannot read SVG {name}: invalid attribute value ({type(exc).__name__}: {exc})"
+        ) from exc
 
     # Undo the viewBox -> viewport mapping svgelements applies: keep viewBox user units.
     inverse = _IDENTITY

@@ -307,7 +307,12 @@ def cubics_from_path(path) -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
 
 
 def _elevate(cubics: np.ndarray, kinds: np.ndarray) -> None:
-    """Turn line and quadratic rows (stored as ``p0 p0 p3 p3`` / ``p0 q q p3``) into exact cubics, in place."""
+    """Turn line and quadratic rows (``p0 p0 p3 p3`` / ``p0 q q p3``) into exact cubics, in place."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        _elevate_rows(cubics, kinds)
+
+
+def _elevate_rows(cubics: np.ndarray, kinds: np.ndarray) -> None:
     line = kinds == _LINE
     if line.any():
         p0, p3 = cubics[line, 0], cubics[line, 3]
@@ -487,7 +492,9 @@ def sample_uniform(cubics: np.ndarray, n: int, *, dense: int | None = None) -> n
     tt = u - idx
     s = 1.0 - tt
     c = cubics[idx]
-    return (s * s * s) * c[:, 0] + (3 * s * s * tt) * c[:, 1] + (3 * s * tt * tt) * c[:, 2] + (tt**3) * c[:, 3]
+    return (
+        (s * s * s) * c[:, 0] + (3 * s * s * tt) * c[:, 1] + (3 * s * tt * tt) * c[:, 2] + (tt**3) * c[:, 3]
+    )
 
 
 def transform_cubics(cubics: np.ndarray, matrix) -> np.ndarray:

@@ -49,33 +49,56 @@ def corpus():
 
 @pytest.fixture
 def helix_lsys(tmp_path) -> Path:
-    """Write the paper's helix grammar to an .lsys file."""
+    """Write the paper's helix grammar (Fig. 3) to an .lsys file."""
     path = tmp_path / "helix.lsys"
     path.write_text(HELIX_LSYS, encoding="utf-8")
     return path
 
 
 @pytest.fixture
-def window(qtbot, tmp_path):
-    """A main window with its own settings file, no autosave; checks that no worker survives it."""
+def make_window(qtbot, tmp_path):
+    """Return a factory of main windows with their own settings file and no autosave.
+
+    At teardown every window is closed and no worker thread may be left running.
+    """
     from PySide6.QtCore import QSettings
 
     from app.main_window import MainWindow
 
     before = set(threading.enumerate())
-    settings = QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat)
-    win = MainWindow(settings, restore_layout=False, autosave=False)
-    qtbot.addWidget(win)
-    win.resize(1200, 800)
-    win.show()
-    yield win
-    win.doc.undo_stack.setClean()
-    win.close()
-    win.shutdown()
+    windows = []
+
+    def make(**kwargs):
+        settings = QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat)
+        kwargs.setdefault("restore_layout", False)
+        kwargs.setdefault("autosave", False)
+        win = MainWindow(settings, **kwargs)
+        qtbot.addWidget(win)
+        win.resize(1000, 700)
+        win.show()
+        windows.append(win)
+        return win
+
+    yield make
+    for win in windows:
+        win.doc.undo_stack.setClean()
+        win.close()
+        win.shutdown()
     left = [t for t in threading.enumerate() if t not in before and t.is_alive() and t.name.startswith("lsys-")]
     assert not left, f"worker threads still running after close: {left}"
 
 
-def wait_idle(qtbot, win, timeout: int = 20000) -> None:
-    """Wait until inference, derivation and rendering have finished."""
-    qtbot.waitUntil(win.is_idle, timeout=timeout)
+@pytest.fixture
+def window(make_window):
+    """One main window (see :func:`make_window`)."""
+    return make_window()
+
+
+@pytest.fixture
+def wait_idle(qtbot):
+    """Return ``wait(win)``: wait until inference, derivation and rendering have finished."""
+
+    def wait(win, timeout: int = 30000) -> None:
+        qtbot.waitUntil(win.is_idle, timeout=timeout)
+
+    return wait

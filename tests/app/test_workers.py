@@ -122,3 +122,21 @@ def test_process_compute_returns_results_and_cancels(qtbot):
         runner.shutdown()
     finally:
         compute.close()
+
+
+def test_signal_emit_keeps_reference_counts():
+    """PySide6 6.12.0's ``emit`` returns ``True`` without a reference: every emit from Python
+    then frees a reference it does not own, until the interpreter aborts (pinned out in
+    pyproject.toml); fail early if such a version is installed."""
+    import sys
+
+    from PySide6.QtCore import QObject, Signal
+
+    class Probe(QObject):
+        ping = Signal(int)
+
+    probe = Probe()
+    before = sys.getrefcount(True)
+    for i in range(50):
+        probe.ping.emit(i)
+    assert sys.getrefcount(True) >= before

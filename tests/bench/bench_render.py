@@ -54,7 +54,9 @@ def main() -> None:
         runs = 5 if n <= 10_000 else 3
         full = median_time(lambda d=drawing: renderer.draw(d, antialias=True), runs)
         draft = median_time(lambda d=drawing: renderer.draw(d, draft=True), runs)
-        print(f"{n:>7} instances at {WIDTH}x{HEIGHT}: full {full * 1000:8.1f} ms   draft {draft * 1000:8.1f} ms")
+        print(
+            f"{n:>7} instances at {WIDTH}x{HEIGHT}: full {full * 1000:8.1f} ms   draft {draft * 1000:8.1f} ms"
+        )
 
 
 if __name__ == "__main__":

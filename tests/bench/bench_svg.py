@@ -24,7 +24,8 @@ def write_paths(path: Path, n: int, seed: int = 0) -> None:
     for i, (x, y) in enumerate(xy.tolist()):
         d = f"M{x:.3f},{y:.3f} c6,-6 16,-5 22,0 c-7,3 -16,6 -22,0 z"
         if i % 3 == 0:
-            parts.append(f'<g transform="rotate({i % 360} {x:.3f} {y:.3f})"><path id="p{i}" fill="#2e7d32" d="{d}"/></g>')
+            rotate = f"rotate({i % 360} {x:.3f} {y:.3f})"
+            parts.append(f'<g transform="{rotate}"><path id="p{i}" fill="#2e7d32" d="{d}"/></g>')
         else:
             parts.append(f'<path id="p{i}" fill="none" stroke="#1b5e20" stroke-width="1" d="{d}"/>')
     parts.append("</svg>")

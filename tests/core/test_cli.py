@@ -1,0 +1,81 @@
+"""The `lsys` command: contract of infer/derive/symmetrize/params and its error handling."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from .shared import CORPUS, ROOT, need
+
+LSYS = [sys.executable, "-m", "lsys_core.cli"]
+
+
+def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run([*LSYS, *args], capture_output=True, text=True, timeout=120, cwd=cwd or ROOT)
+
+
+def test_version_and_help() -> None:
+    assert run("--version").stdout.startswith("lsys ")
+    assert "infer" in run("--help").stdout
+
+
+def test_infer_writes_rules_svg_and_report(tmp_path) -> None:
+    svg = need(CORPUS / "sequence5.svg")
+    rules, out, rep = tmp_path / "r.lsys", tmp_path / "o.svg", tmp_path / "r.json"
+    p = run("infer", str(svg), "-o", str(rules), "--svg", str(out), "--report", str(rep))
+    assert p.returncode == 0, p.stderr
+    report = json.loads(rep.read_text())
+    assert report["elements"] == 5
+    assert len(report["rules"]) == 2
+    assert report["axiom"]
+    for key in ("svg_import", "similarity", "transforms", "clustering", "rules", "derivation"):
+        assert key in report["stages"]
+    derived = tmp_path / "d.svg"
+    assert run("derive", str(rules), "-o", str(derived)).returncode == 0
+    assert derived.read_text().count("<path") == 5
+
+
+def test_derive_set_and_randomize(tmp_path) -> None:
+    rules = ROOT / "tests" / "data" / "helix_truth.lsys"
+    out = tmp_path / "o.svg"
+    p = run("derive", str(rules), "-o", str(out), "--set", "axiom.0.3.m=9", "--randomize", "angle=3", "--seed", "4")
+    assert p.returncode == 0, p.stderr
+    assert out.read_text().count("<path") == 10
+    params = run("params", str(rules)).stdout
+    assert "axiom.0.3.m" in params
+
+
+@pytest.mark.parametrize(
+    "args,needle",
+    [
+        (["derive", "missing.lsys", "-o", "X"], "cannot read"),
+        (["derive", "BAD", "-o", "X"], "1:1"),
+        (["derive", "HUGE", "-o", "X"], "element limit"),
+        (["infer", "NOTSVG"], "error"),
+        (["derive", "HUGE", "-o", "X", "--randomize", "angle=x"], "--randomize"),
+    ],
+)
+def test_errors_are_one_line_and_keep_files(tmp_path, args, needle) -> None:
+    (tmp_path / "BAD").write_text("this is not a grammar\n")
+    (tmp_path / "HUGE").write_text(
+        'lsys 1\nterminal A "M0 0 L1 0"\naxiom: P(1000000000)\nP(m): m > 0 -> A f(1) P(m-1)\nP(m): m == 0 -> A\n'
+    )
+    (tmp_path / "NOTSVG").write_bytes(b"\x00\x01binary junk")
+    (tmp_path / "X").write_text("precious")
+    p = run(*args, cwd=tmp_path)
+    assert p.returncode == 1
+    assert "Traceback" not in p.stderr
+    assert p.stderr.startswith("lsys: error:")
+    assert needle in p.stderr
+    assert len(p.stderr.strip().splitlines()) == 1
+    assert (tmp_path / "X").read_text() == "precious"
+
+
+def test_usage_error_exits_2() -> None:
+    p = run("derive")
+    assert p.returncode == 2
+    assert "Traceback" not in p.stderr
