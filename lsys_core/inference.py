@@ -461,6 +461,10 @@ def _tree_nodes(root: int, depth: int, c1: np.ndarray, c2: np.ndarray) -> np.nda
     return out if np.unique(out).size == out.size and (out >= 0).all() else None
 
 
+#: Step clusters (Δα, Δβ) examined per (d, s) cluster, largest first: smaller ones cannot win.
+_STEP_CLUSTERS = 3
+
+
 def _linear_candidates(bld, sym, ps, prox, size, key) -> list[_Candidate]:
     """Sequences whose α and β change by a constant step (clusters D in the (d, s) subspace)."""
     tol = bld.tol
@@ -476,24 +480,16 @@ def _linear_candidates(bld, sym, ps, prox, size, key) -> list[_Candidate]:
         if g.size < 2:
             continue
         idx = sel[g]
-        # Consecutive pairs (i→j, j→k) and their steps in α and β.
-        by_src: dict[int, list[int]] = {}
-        for k in idx:
-            by_src.setdefault(int(ps.src[k]), []).append(int(k))
-        e1, e2 = [], []
-        for k in idx:
-            for k2 in by_src.get(int(ps.dst[k]), ()):
-                if ps.dst[k2] != ps.src[k]:
-                    e1.append(int(k))
-                    e2.append(k2)
-        if len(e1) < 1:
+        e1a, e2a = _successor_pairs(ps.src, ps.dst, idx)
+        if e1a.size < 1:
             continue
-        e1a, e2a = np.array(e1), np.array(e2)
         da = np.deg2rad(wrap_deg(ps.alpha[e2a] - ps.alpha[e1a]))
         db = np.deg2rad(wrap_deg(ps.beta[e2a] - ps.beta[e1a]))
         emb2 = np.column_stack([np.cos(da), np.sin(da), np.cos(db), np.sin(db)]) / ang
         lab2, modes = mean_shift(emb2)
-        for g2 in _group_indices(lab2):
+        for g2 in _group_indices(lab2)[:_STEP_CLUSTERS]:
+            if g2.size < 2:
+                continue  # a single consecutive pair is no sequence
             dA = float(np.rad2deg(np.arctan2(emb2[g2, 1].mean(), emb2[g2, 0].mean())))
             dB = float(np.rad2deg(np.arctan2(emb2[g2, 3].mean(), emb2[g2, 2].mean())))
             if abs(dA) < tol.angle and abs(dB) < tol.angle:
@@ -504,22 +500,41 @@ def _linear_candidates(bld, sym, ps, prox, size, key) -> list[_Candidate]:
     return out
 
 
-def _linear_chains(bld, sym, ps, e1, e2, dA, dB, prox) -> _Candidate | None:
-    nxt: dict[int, int] = {}
-    prv: dict[int, int] = {}
-    for x, y in zip(e1.tolist(), e2.tolist(), strict=True):
-        if x in nxt or y in prv or x == y:
-            continue
-        nxt[x] = y
-        prv[y] = x
-    chains_e = []
+def _successor_pairs(src: np.ndarray, dst: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """All pairs of pairs ``(i→j, j→k)`` with ``k != i`` among the pair indices ``idx``."""
+    order = np.argsort(src[idx], kind="stable")
+    s_sorted = src[idx][order]
+    lo = np.searchsorted(s_sorted, dst[idx], "left")
+    cnt = np.searchsorted(s_sorted, dst[idx], "right") - lo
+    e1 = np.repeat(idx, cnt)
+    offs = np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+    e2 = idx[order][np.repeat(lo, cnt) + offs]
+    keep = dst[e2] != src[e1]
+    return e1[keep], e2[keep]
+
+
+def _edge_chains(e1: np.ndarray, e2: np.ndarray) -> list[list[int]]:
+    """Follow links ``e1 → e2`` (each pair with at most one successor and predecessor) into chains."""
+    _, first = np.unique(e1, return_index=True)
+    e1, e2 = e1[np.sort(first)], e2[np.sort(first)]
+    _, first = np.unique(e2, return_index=True)
+    e1, e2 = e1[np.sort(first)], e2[np.sort(first)]
+    keep = e1 != e2
+    nxt = dict(zip(e1[keep].tolist(), e2[keep].tolist(), strict=True))
+    has_prev = set(nxt.values())
+    chains = []
     for s0 in nxt:
-        if s0 in prv:
+        if s0 in has_prev:
             continue
         ch = [s0]
-        while ch[-1] in nxt and len(ch) <= len(nxt):
+        while ch[-1] in nxt:
             ch.append(nxt[ch[-1]])
-        chains_e.append(ch)
+        chains.append(ch)
+    return chains
+
+
+def _linear_chains(bld, sym, ps, e1, e2, dA, dB, prox) -> _Candidate | None:
+    chains_e = _edge_chains(e1, e2)
     # Node-disjoint chains only (greedy, longest first).
     chains_e.sort(key=len, reverse=True)
     taken: set[int] = set()

@@ -28,7 +28,7 @@ from .similarity_exact import EXACT_TOL, fit_exact, structure_key, variants
 from .similarity_match import PERFECT, Batch, Reference, match_batch
 from .similarity_sampling import Samples, arc_fractions, element_features, sample_elements
 
-__all__ = ["detect_similarity", "format_cubics", "symmetry_order", "terminal_name"]
+__all__ = ["detect_similarity", "symmetry_order", "terminal_name"]
 
 #: Samples per element for voting, ICP and φ; the representative gets ``_DENSE`` times more.
 _SAMPLES = 96
@@ -43,56 +43,12 @@ def terminal_name(index: int) -> str:
     return letter if index < 26 else f"{letter}{index // 26}"
 
 
-def _num(v: float) -> str:
-    """Format a coordinate compactly (at most 4 decimals, no trailing zeros)."""
-    s = f"{v:.4f}".rstrip("0").rstrip(".")
-    return "0" if s in ("-0", "") else s
-
-
-def _pt(z: complex) -> str:
-    return f"{_num(z.real)},{_num(z.imag)}"
-
-
-def format_cubics(cubics: np.ndarray, subpaths: np.ndarray, closed: tuple[bool, ...]) -> str:
-    """Format cubic segments as SVG path data, writing straight segments as ``L``.
-
-    Parameters
-    ----------
-    cubics : ndarray of complex, shape (k, 4)
-        Control points.
-    subpaths : ndarray of int, shape (k,)
-        Subpath index of every segment.
-    closed : tuple of bool
-        Whether each subpath is closed.
-    """
-    out: list[str] = []
-    prev = None
-    for i, seg in enumerate(np.asarray(cubics, dtype=complex).reshape(-1, 4)):
-        sp = int(subpaths[i])
-        if sp != prev:
-            if prev is not None and prev < len(closed) and closed[prev]:
-                out.append("Z")
-            out.append(f"M{_pt(seg[0])}")
-            prev = sp
-        chord = seg[3] - seg[0]
-        size = max(abs(chord), 1e-12)
-        rel = (seg[1:3] - seg[0]) * np.conj(chord) / size
-        straight = np.all(np.abs(rel.imag) <= 1e-9 * size) and np.all(rel.real >= -1e-9 * size * size)
-        straight = straight and np.all(rel.real <= size * size * (1 + 1e-9))
-        out.append(f"L{_pt(seg[3])}" if straight else f"C{_pt(seg[1])} {_pt(seg[2])} {_pt(seg[3])}")
-    if prev is not None and prev < len(closed) and closed[prev]:
-        out.append("Z")
-    return " ".join(out)
-
-
 def _path_data(element: Element, origin: complex) -> str:
-    """Return the element's path data translated by ``-origin`` (the pathdata module's if present)."""
+    """Return the element's path data translated by ``-origin``."""
+    from .svg.pathdata import d_from_cubics
+
     cubics = np.asarray(element.cubics, dtype=complex).reshape(-1, 4) - origin
-    try:
-        from .svg.pathdata import d_from_cubics
-    except ImportError:
-        return format_cubics(cubics, element.subpaths, element.closed)
-    return d_from_cubics(cubics, element.subpaths, element.closed)
+    return d_from_cubics(cubics, np.asarray(element.subpaths), tuple(element.closed))
 
 
 def _style_key(style: str) -> str:
@@ -169,41 +125,34 @@ def _canonical(a: np.ndarray, period: int) -> np.ndarray:
 
 
 def _sample_all(elements, fractions, cancel) -> Samples:
-    """Sample all elements in chunks, checking the cancel token in between."""
+    """Sample all elements in chunks, checking the cancel token in between.
+
+    Only single open paths are sampled precisely: their poses are pinned down by arc length
+    (closed outlines are matched through foot points, where sample placement does not matter).
+    """
+    precise = np.array([len(e.closed) == 1 and not e.closed[0] for e in elements], dtype=bool)
     parts = []
     for lo in range(0, len(elements), 4 * _CHUNK):
         check(cancel)
-        parts.append(sample_elements(elements[lo : lo + 4 * _CHUNK], fractions))
+        hi = lo + 4 * _CHUNK
+        parts.append(sample_elements(elements[lo:hi], fractions, precise[lo:hi]))
     return Samples(*(np.concatenate([getattr(p, f) for p in parts]) for f in Samples.__dataclass_fields__))
 
 
 class _Rep:
-    """A representative: its element index, local origin, dense samples and references."""
+    """A representative: its element index, local origin (centroid), size and reference."""
 
     def __init__(self, element: Element, index: int, coarse: Samples):
         # (k + 0.5) / m with an odd factor: unbiased, and the coarse samples are among them
-        dense_frac = arc_fractions(_SAMPLES * _DENSE)
-        dense = sample_elements([element], dense_frac)
+        fractions = arc_fractions(_SAMPLES * _DENSE)
+        dense = sample_elements([element], fractions)
         self.index = index
         self.origin = complex(dense.points[0].mean())
         rel = dense.points[0] - self.origin
         self.radius = float(np.sqrt(np.mean(np.abs(rel) ** 2)))
-        inv = 1.0 / self.radius
-        self.dense = rel * inv
-        self.dense_normals = dense.normals[0]
-        self.ref = Reference.build(
-            (coarse.points[index] - self.origin) * inv,
-            coarse.normals[index],
-            coarse.curvature[index] * self.radius,
-            self.dense,
-            self.dense_normals,
-            float(dense.length[0]) * inv,
-            0.5,
-            len(element.closed) == 1 and not element.closed[0],
-            (np.asarray(element.cubics, dtype=complex).reshape(-1, 4) - self.origin) * inv,
-            dense.segment[0],
-            dense.param[0],
-        )
+        row = Samples(*(getattr(coarse, f)[index : index + 1] for f in Samples.__dataclass_fields__))
+        open_path = len(element.closed) == 1 and not element.closed[0]
+        self.ref = Reference.build(row, dense, fractions, element.cubics, self.origin, self.radius, open_path)
         self.control = np.asarray(element.cubics, dtype=complex).ravel()
         self.orders = variants(element)
 
@@ -402,7 +351,7 @@ def detect_similarity(
         if rep is None:
             symmetry[g] = 0
             continue
-        order, period = symmetry_order(rep.dense, rep.dense_normals)
+        order, period = symmetry_order(rep.ref.dense, rep.ref.dense_normals)
         symmetry[g] = order
         sel = group == g
         a[sel] = _canonical(a[sel], period)

@@ -48,7 +48,7 @@ def variants(element: Element) -> np.ndarray | None:
     return np.array(orders)
 
 
-def fit_exact(rep: np.ndarray, orders: np.ndarray, cands: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def fit_exact(rep: np.ndarray, orders: np.ndarray, cands: np.ndarray) -> tuple[np.ndarray, ...]:
     """Fit ``cand ≈ a * rep + b`` over all control-point orders; keep the best per candidate.
 
     Parameters

@@ -18,7 +18,7 @@ import numpy as np
 from scipy.ndimage import uniform_filter1d
 from scipy.spatial import cKDTree
 
-from .similarity_sampling import bezier
+from .similarity_sampling import Samples, bezier
 
 __all__ = ["PERFECT", "Batch", "MatchResult", "Reference", "match_batch"]
 
@@ -48,9 +48,11 @@ _CONVERGED = 1e-9
 class Reference:
     """A representative shape in its normalised local frame (centroid 0, RMS radius 1).
 
-    ``points``/``normals``/``curvature`` are the coarse samples used for voting;
-    ``dense``/``dense_normals`` (a superset, in arc-length order) and ``tree`` serve ICP and
-    scoring; ``dense_step`` is the arc length between dense samples.
+    ``points``/``normals``/``curvature`` are its coarse samples, used for voting.  The
+    dense samples (``dense``, ``dense_normals``; at arc-length fractions ``dense_frac``, in
+    order, on cubic ``dense_seg`` of ``cubics`` at parameter ``dense_t``) serve ICP and
+    scoring through ``tree``; ``dense_step`` is the arc length between them.
+    ``open_path`` says whether the shape is a single open subpath.
     """
 
     points: np.ndarray
@@ -58,36 +60,51 @@ class Reference:
     curvature: np.ndarray
     dense: np.ndarray
     dense_normals: np.ndarray
+    dense_frac: np.ndarray
+    dense_seg: np.ndarray
+    dense_t: np.ndarray
+    cubics: np.ndarray
+    dense_step: float
+    open_path: bool
     tree: cKDTree
     order: np.ndarray
     radius_sorted: np.ndarray
-    dense_step: float
-    dense_frac: np.ndarray
-    dense_frac_start: float
-    open_path: bool
-    cubics: np.ndarray
-    dense_seg: np.ndarray
-    dense_t: np.ndarray
 
     @classmethod
     def build(
-        cls, points, normals, curvature, dense, dense_normals, length: float, start: float, open_path: bool,
-        cubics: np.ndarray, dense_seg: np.ndarray, dense_t: np.ndarray,
+        cls,
+        coarse: Samples,
+        dense: Samples,
+        dense_frac: np.ndarray,
+        cubics: np.ndarray,
+        origin: complex,
+        radius: float,
+        open_path: bool,
     ) -> Reference:
-        """Build a reference from normalised samples, its normalised length and the dense offset.
+        """Build a reference from one element's coarse and dense samples (row 0 of each).
 
-        The dense sample ``k`` lies at the arc-length fraction ``((k + start) / m) % 1``, on
-        cubic ``dense_seg[k]`` of the normalised ``cubics`` at parameter ``dense_t[k]``;
-        ``open_path`` says whether the shape is a single open subpath.
+        ``origin`` and ``radius`` define the normalised frame ``(z - origin) / radius``.
         """
+        inv = 1.0 / radius
+        points = (coarse.points[0] - origin) * inv
         rho = np.abs(points)
         order = np.argsort(rho, kind="stable")
-        tree = cKDTree(np.column_stack([dense.real, dense.imag]))
-        m = dense.size
-        frac = ((np.arange(m) + start) / m) % 1.0
+        pts = (dense.points[0] - origin) * inv
         return cls(
-            points, normals, curvature, dense, dense_normals, tree, order, rho[order], length / m, frac, start,
-            open_path, cubics, dense_seg, dense_t,
+            points=points,
+            normals=coarse.normals[0],
+            curvature=coarse.curvature[0] * radius,
+            dense=pts,
+            dense_normals=dense.normals[0],
+            dense_frac=dense_frac,
+            dense_seg=dense.segment[0],
+            dense_t=dense.param[0],
+            cubics=(np.asarray(cubics, dtype=complex).reshape(-1, 4) - origin) * inv,
+            dense_step=float(dense.length[0]) * inv / pts.size,
+            open_path=open_path,
+            tree=cKDTree(np.column_stack([pts.real, pts.imag])),
+            order=order,
+            radius_sorted=rho[order],
         )
 
 
@@ -117,7 +134,7 @@ class MatchResult:
 def _votes(ref: Reference, batch: Batch, stride: int):
     """Cast the transform votes of all radius- and curvature-compatible sample pairs."""
     q = batch.points[:, ::stride]
-    b, s = q.shape
+    s = q.shape[1]
     rho_q = np.abs(q).ravel()
     lo = np.searchsorted(ref.radius_sorted, rho_q - _RADIUS_TOL, side="left")
     hi = np.searchsorted(ref.radius_sorted, rho_q + _RADIUS_TOL, side="right")
@@ -246,7 +263,7 @@ def _arc_targets(ref: Reference, nn: np.ndarray, u: np.ndarray) -> np.ndarray:
     w = np.where(forward[:, None], u, 1.0 - u)
     agree = np.where(forward[:, None], fwd, bwd)
     m = ref.dense.size
-    pos = w * m - ref.dense_frac_start
+    pos = (w - ref.dense_frac[0]) * m
     k0 = np.floor(pos).astype(np.int64)
     t = pos - k0
     lo, hi = np.clip(k0, 0, m - 1), np.clip(k0 + 1, 0, m - 1)
@@ -272,9 +289,16 @@ def _icp(ref: Reference, q, qn, c, d, iters: int, u=None, exact: bool = False):
     """
     b, s = q.shape
     active = np.ones(b, bool)
-    near = (np.zeros((b, s)), np.zeros((b, s), np.int64), np.zeros((b, s), bool),
-            np.zeros((b, s), complex), np.ones((b, s), complex))
-    lam = _P2P_WEIGHT
+    near = (
+        np.zeros((b, s)),
+        np.zeros((b, s), np.int64),
+        np.zeros((b, s), bool),
+        np.zeros((b, s), complex),
+        np.ones((b, s), complex),
+    )
+    # foot points slide with the candidate, so a point-to-point pull towards them has the
+    # wrong Jacobian and slows convergence: keep it faint unless it follows arc length
+    lam = _P2P_WEIGHT if (u is not None or not exact) else 0.1 * _P2P_WEIGHT
     for _ in range(iters):
         idx = np.flatnonzero(active)
         if idx.size == 0:
@@ -336,7 +360,8 @@ def _score(ref: Reference, q, qn, c, d, near, perimeter):
     forward = inl.mean(axis=1)
     line = ((c[:, None] * q + d[:, None] - foot) * np.conj(n)).real
     cnt = inl.sum(axis=1)
-    gap = np.where(cnt > 0, np.sqrt(np.sum(np.where(inl, line * line, 0.0), axis=1) / np.maximum(cnt, 1)), _FAR)
+    sq = np.sum(np.where(inl, line * line, 0.0), axis=1)
+    gap = np.where(cnt > 0, np.sqrt(sq / np.maximum(cnt, 1)), _FAR)
     m = ref.dense.size
     hits = np.zeros((b, m), np.int32)
     rows = np.repeat(np.arange(b), s)
@@ -405,14 +430,16 @@ def match_batch(
         k = sc - 2.0 * gap
         better = k > key[rows]
         sel = rows[better]
-        c1[sel], d1[sel], key[sel], best[sel], gap1[sel] = c[better], d[better], k[better], sc[better], gap[better]
+        c1[sel], d1[sel], key[sel] = c[better], d[better], k[better]
+        best[sel], gap1[sel] = sc[better], gap[better]
         # another peak only for imperfect fits that are not hopeless
         rows = rows[((sc < 1.0) | (gap >= PERFECT)) & (best[rows] >= 0.5 * threshold)]
     phi, gap = best.copy(), gap1
     fine = np.flatnonzero(best >= threshold - _COARSE_MARGIN)
     if fine.size:
-        u = (np.arange(batch.points.shape[1]) + 0.5) / batch.points.shape[1] if ref.open_path else None
-        c2, d2, near = _icp(ref, batch.points[fine], batch.normals[fine], c1[fine], d1[fine], _FINE_ITERS, u, True)
-        phi[fine], gap[fine] = _score(ref, batch.points[fine], batch.normals[fine], c2, d2, near, perimeter[fine])
+        q, qn = batch.points[fine], batch.normals[fine]
+        u = (np.arange(q.shape[1]) + 0.5) / q.shape[1] if ref.open_path else None
+        c2, d2, near = _icp(ref, q, qn, c1[fine], d1[fine], _FINE_ITERS, u, exact=True)
+        phi[fine], gap[fine] = _score(ref, q, qn, c2, d2, near, perimeter[fine])
         c1[fine], d1[fine] = c2, d2
     return MatchResult(phi, gap, c1, d1)

@@ -84,7 +84,9 @@ def make_window(qtbot, tmp_path):
         win.doc.undo_stack.setClean()
         win.close()
         win.shutdown()
-    left = [t for t in threading.enumerate() if t not in before and t.is_alive() and t.name.startswith("lsys-")]
+    left = [
+        t for t in threading.enumerate() if t not in before and t.is_alive() and t.name.startswith("lsys-")
+    ]
     assert not left, f"worker threads still running after close: {left}"
 
 

@@ -5,9 +5,8 @@ from __future__ import annotations
 import threading
 import time
 
-from lsys_core.errors import InferenceError
-
 from app.workers import LatestRunner, ProcessCompute
+from lsys_core.errors import InferenceError
 
 
 def _slow_echo(request, cancel, progress):
