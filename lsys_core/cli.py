@@ -47,7 +47,9 @@ def _weights(p: argparse.ArgumentParser) -> None:
     g.add_argument("--wh", type=float, help="weight of proximity h, in [0, 1]")
     g.add_argument("--wphi", type=float, help="weight of similarity φ, in [0, 1]")
     g.add_argument("--wl", type=float, help="weight of sequence length l, in [0, 1]")
-    g.add_argument("--similarity", type=float, help="similarity threshold φ for shared terminals (default 0.6)")
+    g.add_argument(
+        "--similarity", type=float, help="similarity threshold φ for shared terminals (default 0.6)"
+    )
     g.add_argument("--tolerance", type=float, help="factor on the clustering bandwidths (default 1)")
 
 
@@ -66,7 +68,9 @@ def _parser() -> argparse.ArgumentParser:
     inf.add_argument("-o", "--output", help="write the rules (.lsys); default: print them")
     inf.add_argument("--svg", help="write the derivation of the inferred rules as SVG")
     inf.add_argument("--png", help="write the derivation as PNG")
-    inf.add_argument("--report", help="write a JSON report (elements, symbols, rules, axiom, seconds, stages)")
+    inf.add_argument(
+        "--report", help="write a JSON report (elements, symbols, rules, axiom, seconds, stages)"
+    )
     _weights(inf)
 
     sym = sub.add_parser("symmetrize", help="regularise a jittered pattern through relaxed inference")
@@ -79,10 +83,18 @@ def _parser() -> argparse.ArgumentParser:
     der.add_argument("rules", help="rules file (.lsys)")
     der.add_argument("-o", "--output", required=True, help="output SVG")
     der.add_argument("--png", help="also write a PNG")
-    der.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                     help="set a rule parameter (see `lsys params`); repeatable")
-    der.add_argument("--randomize", metavar="angle=DEG,distance=FRAC,scale=FRAC",
-                     help="perturb every rule application by up to these amounts")
+    der.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="set a rule parameter (see `lsys params`); repeatable",
+    )
+    der.add_argument(
+        "--randomize",
+        metavar="angle=DEG,distance=FRAC,scale=FRAC",
+        help="perturb every rule application by up to these amounts",
+    )
     der.add_argument("--seed", type=int, default=0, help="random seed for --randomize (default 0)")
     der.add_argument("--limit", type=int, default=None, help="maximum number of elements (default 1,000,000)")
 
@@ -172,7 +184,9 @@ def _infer_report(result, scene, drawing) -> dict:
     g = result.grammar
     text = format_grammar(g)
     rules = [line for line in text.splitlines() if "->" in line and not line.startswith("axiom")]
-    axiom = next((line.split(":", 1)[1].strip() for line in text.splitlines() if line.startswith("axiom:")), "")
+    axiom = next(
+        (line.split(":", 1)[1].strip() for line in text.splitlines() if line.startswith("axiom:")), ""
+    )
     return {
         "elements": len(scene.elements),
         "symbols": len(g.terminals) + len(g.rules),

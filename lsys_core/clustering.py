@@ -22,9 +22,19 @@ def _row_keys(cells: np.ndarray) -> np.ndarray:
     Two large odd multipliers per column make a collision between distinct occupied cells
     astronomically unlikely (~n²/2⁶⁴); a collision would only merge two seeds' cells.
     """
-    mult = np.array([0x9E3779B97F4A7C15, 0xC2B2AE3D27D4EB4F, 0x165667B19E3779F9, 0xD6E8FEB86659FD93,
-                     0xFF51AFD7ED558CCD, 0xC4CEB9FE1A85EC53, 0x2545F4914F6CDD1D, 0x9FB21C651E98DF25],
-                    dtype=np.uint64)
+    mult = np.array(
+        [
+            0x9E3779B97F4A7C15,
+            0xC2B2AE3D27D4EB4F,
+            0x165667B19E3779F9,
+            0xD6E8FEB86659FD93,
+            0xFF51AFD7ED558CCD,
+            0xC4CEB9FE1A85EC53,
+            0x2545F4914F6CDD1D,
+            0x9FB21C651E98DF25,
+        ],
+        dtype=np.uint64,
+    )
     k = cells.shape[1]
     reps = -(-k // mult.size)
     m = np.tile(mult, reps)[:k]
@@ -34,7 +44,9 @@ def _row_keys(cells: np.ndarray) -> np.ndarray:
     return h.view(np.int64)
 
 
-def mean_shift(points: np.ndarray, *, max_iter: int = 30, min_count: int = 1) -> tuple[np.ndarray, np.ndarray]:
+def mean_shift(
+    points: np.ndarray, *, max_iter: int = 30, min_count: int = 1
+) -> tuple[np.ndarray, np.ndarray]:
     """Cluster ``points`` (already scaled to bandwidth 1) by mean shift.
 
     Parameters

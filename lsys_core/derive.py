@@ -293,8 +293,11 @@ def derive(
         work += m.size
         if m.size > limit or work > work_budget:
             raise LimitError(f"derivation exceeds the element limit ({limit:,} elements) in {where}")
-        masks = _case_masks(rule.cases, m) if rule.parametric else [np.ones(m.size, bool)] + [
-            np.zeros(m.size, bool)] * (len(rule.cases) - 1)
+        masks = (
+            _case_masks(rule.cases, m)
+            if rule.parametric
+            else [np.ones(m.size, bool)] + [np.zeros(m.size, bool)] * (len(rule.cases) - 1)
+        )
         for ci, case in enumerate(compiled[r]):
             sel = masks[ci]
             if not sel.any():

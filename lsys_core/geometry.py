@@ -18,9 +18,9 @@ __all__ = [
     "compose",
     "frames_to_matrices",
     "invert",
+    "rel_from_t4",
     "relative",
     "t4_from_rel",
-    "rel_from_t4",
     "wrap_deg",
 ]
 

@@ -250,7 +250,9 @@ def build_hierarchy(
         if cands:
             best = _select(cands, bld.weights)
             level += 1
-            sym, a, b, center, radius, members = _apply(bld, best, sym, a, b, center, radius, members, node_rule)
+            sym, a, b, center, radius, members = _apply(
+                bld, best, sym, a, b, center, radius, members, node_rule
+            )
         clock["transforms"] += t1 - t0
         clock["clustering"] += t2 - t1
         clock["rules"] += time.perf_counter() - t2
@@ -266,11 +268,14 @@ def build_hierarchy(
         a0, b0 = a[0], b[0]
         for i in range(a.size):
             t = _const_t(a[i] / a0, (b[i] - b0) / a0)
-            body += [Push(), *t, *bld.draw(int(sym[i]), last=True), Pop()] if i else [
-                Push(), *bld.draw(int(sym[i]), last=True), Pop()]
+            body += (
+                [Push(), *t, *bld.draw(int(sym[i]), last=True), Pop()]
+                if i
+                else [Push(), *bld.draw(int(sym[i]), last=True), Pop()]
+            )
         bld.rules.append(Rule(name, False, (Case(None, tuple(body)),)))
         bld.log.append(f"{name}: places the {a.size} remaining nodes")
-        axiom = _const_t(a0, b0) + (Symbol(name),)
+        axiom = (*_const_t(a0, b0), Symbol(name))
         for mem in members:
             node_rule[mem[node_rule[mem] < 0]] = len(bld.rules) - 1
     report(progress, "rules", 1.0)
@@ -307,14 +312,16 @@ def _candidates(bld: _Builder, sym, a, b, ps: PairSpace, radius: np.ndarray) -> 
     key = _space_key(sym, ps)
     th = np.angle(ps.A)
     ang = np.deg2rad(tol.angle)
-    emb = np.column_stack([
-        ps.B.real / (tol.xy * size),
-        ps.B.imag / (tol.xy * size),
-        np.cos(th) / ang,
-        np.sin(th) / ang,
-        np.log(np.abs(ps.A)) / tol.scale,
-        key * 1e7,
-    ])
+    emb = np.column_stack(
+        [
+            ps.B.real / (tol.xy * size),
+            ps.B.imag / (tol.xy * size),
+            np.cos(th) / ang,
+            np.sin(th) / ang,
+            np.log(np.abs(ps.A)) / tol.scale,
+            key * 1e7,
+        ]
+    )
     labels, _ = mean_shift(emb)
     prox = _proximity(ps, a.size, radius)
     out: list[_Candidate] = []
@@ -462,7 +469,7 @@ def _tree_nodes(root: int, depth: int, c1: np.ndarray, c2: np.ndarray) -> np.nda
 
 
 #: Step clusters (Δα, Δβ) examined per (d, s) cluster, largest first: smaller ones cannot win.
-_STEP_CLUSTERS = 3
+_STEP_CLUSTERS = 12
 
 
 def _linear_candidates(bld, sym, ps, prox, size, key) -> list[_Candidate]:
@@ -486,7 +493,7 @@ def _linear_candidates(bld, sym, ps, prox, size, key) -> list[_Candidate]:
         da = np.deg2rad(wrap_deg(ps.alpha[e2a] - ps.alpha[e1a]))
         db = np.deg2rad(wrap_deg(ps.beta[e2a] - ps.beta[e1a]))
         emb2 = np.column_stack([np.cos(da), np.sin(da), np.cos(db), np.sin(db)]) / ang
-        lab2, modes = mean_shift(emb2)
+        lab2, _ = mean_shift(emb2)
         for g2 in _group_indices(lab2)[:_STEP_CLUSTERS]:
             if g2.size < 2:
                 continue  # a single consecutive pair is no sequence
@@ -611,8 +618,10 @@ def _apply(bld: _Builder, c: _Candidate, sym, a, b, center, radius, members, nod
         for ch in c.groups:
             groups.append(np.array(ch))
             new_syms.append(bld.sym_id(name, len(ch) - 1, 0.0, name))
-        bld.log.append(f"{name}: {len(c.groups)} sequences of {bld.syms[si].name}, lengths "
-                       f"{sorted({len(ch) for ch in c.groups})}")
+        bld.log.append(
+            f"{name}: {len(c.groups)} sequences of {bld.syms[si].name}, lengths "
+            f"{sorted({len(ch) for ch in c.groups})}"
+        )
     elif c.kind == "lin":
         name = bld.new_name("P")
         al0, d, s, be0, dA, dB, k = c.T
@@ -634,7 +643,9 @@ def _apply(bld: _Builder, c: _Candidate, sym, a, b, center, radius, members, nod
         for root, depth, nodes in c.groups:
             groups.append(np.concatenate([[root], nodes[nodes != root]]))
             new_syms.append(bld.sym_id(name, depth, 0.0, name))
-        bld.log.append(f"{name}: {len(c.groups)} branching structures, depths {sorted({g[1] for g in c.groups})}")
+        bld.log.append(
+            f"{name}: {len(c.groups)} branching structures, depths {sorted({g[1] for g in c.groups})}"
+        )
     # Replace the covered nodes by one node each (pose of the first node).
     keep = np.ones(a.size, bool)
     add_a, add_b, add_c, add_r, add_s, add_m = [], [], [], [], [], []

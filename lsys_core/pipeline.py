@@ -15,6 +15,7 @@ import numpy as np
 from .cancel import CancelToken, Progress, check, report
 from .derive import derive
 from .errors import InferenceError
+from .fidelity import split_unfaithful
 from .grammar.model import Grammar
 from .inference import Tolerance, Weights, build_hierarchy
 from .model import Instancing, Scene
@@ -28,6 +29,9 @@ RELAXED = 12.0
 #: Largest reproduction error (relative to the scene's diagonal) :func:`infer` accepts
 #: when it relaxes the clustering to explain jittered repetitions.
 INFER_ERROR = 0.004
+#: Largest deviation (relative to the scene's diagonal) of an element from the terminal
+#: drawn in its place; elements farther from their group's shape get a terminal of their own.
+SHAPE_ERROR = 0.002
 #: A relaxed grammar may deviate up to this much if it needs at most :data:`JITTER_GAIN`
 #: times the productions of the exact one (jittered repetitions, paper Fig. 10).
 JITTER_ERROR = 0.025
@@ -102,15 +106,14 @@ def _element_circles(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
     return cen, rad
 
 
-def _shape_similarity(inst: Instancing) -> np.ndarray:
-    """Similarity of pairs of terminals for the importance's φ (mirror images count as alike)."""
-    k = len(inst.terminals)
-    sim = np.full((k, k), 0.5)
-    for g, m in enumerate(inst.mirrored_of):
-        if m >= 0:
-            sim[g, m] = sim[m, g] = 0.9
-    np.fill_diagonal(sim, 1.0)
-    return sim
+def _shape_similarity(inst: Instancing, cancel: CancelToken | None) -> np.ndarray:
+    """Similarity of pairs of terminals for the importance's φ (§5.4, mirror images count as alike)."""
+    from .similarity import terminal_similarity
+
+    if len(inst.terminals) > 64:  # pairwise shape matching; beyond this a constant keeps it cheap
+        k = len(inst.terminals)
+        return np.full((k, k), 0.5) + 0.5 * np.eye(k)
+    return terminal_similarity(inst.terminals, cancel=cancel)
 
 
 def _diagonal(center: np.ndarray, radius: np.ndarray) -> float:
@@ -145,7 +148,8 @@ def reproduction_error(inst: Instancing, sizes: np.ndarray, drawing) -> float:
             continue
         tb = drawing.b[theirs]
         _, j = cKDTree(np.column_stack([tb.real, tb.imag])).query(
-            np.column_stack([inst.b[mine].real, inst.b[mine].imag]))
+            np.column_stack([inst.b[mine].real, inst.b[mine].imag])
+        )
         err = np.abs(inst.b[mine] - tb[j]) + sizes[g] * np.abs(inst.a[mine] - drawing.a[theirs][j])
         worst = max(worst, float(err.max()))
     return worst
@@ -198,6 +202,16 @@ def infer(
     stages["similarity"] = time.perf_counter() - t
     check(cancel)
     center, radius = _element_circles(scene)
+    t = time.perf_counter()
+    inst = split_unfaithful(
+        scene,
+        inst,
+        radius,
+        threshold=settings.similarity,
+        absolute=SHAPE_ERROR * _diagonal(center, radius),
+        cancel=cancel,
+    )
+    stages["similarity"] += time.perf_counter() - t
     sizes = np.zeros(len(inst.terminals))
     np.maximum.at(sizes, inst.group, radius / np.maximum(np.abs(inst.a), 1e-300))
     t = time.perf_counter()
@@ -205,18 +219,32 @@ def infer(
     stages["pivots"] = time.perf_counter() - t
     weights = Weights(settings.wn, settings.wh, settings.wphi, settings.wl)
     diag = _diagonal(center, radius)
+    shape_sim = _shape_similarity(inst, cancel)
     best = None
     first_count: int | None = None
     for factor in _factors(settings, symmetrizing):
         check(cancel)
         hier = build_hierarchy(
-            [t.name for t in inst.terminals], sizes, inst.group, inst.a, inst.b, center, radius,
-            weights=weights, tol=Tolerance().scaled(factor), similarity=_shape_similarity(inst),
-            neighbours=settings.neighbours, cancel=cancel, progress=progress, timer=stages,
+            [t.name for t in inst.terminals],
+            sizes,
+            inst.group,
+            inst.a,
+            inst.b,
+            center,
+            radius,
+            weights=weights,
+            tol=Tolerance().scaled(factor),
+            similarity=shape_sim,
+            neighbours=settings.neighbours,
+            cancel=cancel,
+            progress=progress,
+            timer=stages,
         )
         t = time.perf_counter()
         grammar = simplify(Grammar(inst.terminals, tuple(hier.rules), hier.axiom, scene.viewbox, scene.size))
-        error = reproduction_error(inst, sizes, derive(grammar, limit=max(10 * len(scene.elements), 1000))) / diag
+        error = (
+            reproduction_error(inst, sizes, derive(grammar, limit=max(10 * len(scene.elements), 1000))) / diag
+        )
         stages["postprocess"] = stages.get("postprocess", 0.0) + time.perf_counter() - t
         count = grammar.production_count
         if best is None:
@@ -234,7 +262,9 @@ def infer(
     grammar, hier, error = best
     stages["reproduction_error"] = error
     report(progress, "done", 1.0)
-    return InferenceResult(grammar, inst, stages, time.perf_counter() - t_all, hier.node_rule, tuple(hier.log))
+    return InferenceResult(
+        grammar, inst, stages, time.perf_counter() - t_all, hier.node_rule, tuple(hier.log)
+    )
 
 
 def symmetrize(

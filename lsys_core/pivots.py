@@ -49,8 +49,9 @@ def _pivot_for(a: np.ndarray, b: np.ndarray, size: float, tol_angle: float, rng)
         return 0j
     src, dst, A = src[moving], dst[moving], A[moving]
     ang = np.deg2rad(tol_angle)
-    lab, _ = mean_shift(np.column_stack([np.cos(np.angle(A)) / ang, np.sin(np.angle(A)) / ang,
-                                         np.log(np.abs(A)) / 0.01]))
+    lab, _ = mean_shift(
+        np.column_stack([np.cos(np.angle(A)) / ang, np.sin(np.angle(A)) / ang, np.log(np.abs(A)) / 0.01])
+    )
     best, best_support = 0j, 0
     spacing = float(np.median(np.abs(b[dst] - b[src])))
     for g in _group_indices(lab):
@@ -69,7 +70,7 @@ def _pivot_for(a: np.ndarray, b: np.ndarray, size: float, tol_angle: float, rng)
         o = o[np.isfinite(o) & (np.abs(o) < 20 * size)]
         if o.size < 3:
             continue
-        lo, modes = mean_shift(np.column_stack([o.real, o.imag]) / (0.02 * size))
+        _, modes = mean_shift(np.column_stack([o.real, o.imag]) / (0.02 * size))
         if modes.shape[0] == 0:
             continue
         cand = complex(*(modes[0] * 0.02 * size))
@@ -82,7 +83,9 @@ def _pivot_for(a: np.ndarray, b: np.ndarray, size: float, tol_angle: float, rng)
     return best if abs(best) > 0.05 * size else 0j
 
 
-def estimate_pivots(inst: Instancing, sizes: np.ndarray, *, tol_angle: float = 1.0, seed: int = 0) -> np.ndarray:
+def estimate_pivots(
+    inst: Instancing, sizes: np.ndarray, *, tol_angle: float = 1.0, seed: int = 0
+) -> np.ndarray:
     """Return, per terminal, the local offset of its pivot (0 where the centroid is kept).
 
     Parameters

@@ -31,7 +31,9 @@ def _inline(body: tuple[Module, ...], name: str, sub: tuple[Module, ...]) -> tup
     out: list[Module] = []
     for i, mod in enumerate(body):
         if isinstance(mod, Symbol) and mod.name == name:
-            bracketed = i > 0 and isinstance(body[i - 1], Push) and i + 1 < len(body) and isinstance(body[i + 1], Pop)
+            bracketed = (
+                i > 0 and isinstance(body[i - 1], Push) and i + 1 < len(body) and isinstance(body[i + 1], Pop)
+            )
             last = i == len(body) - 1
             out.extend(sub if (bracketed or last) else (Push(), *sub, Pop()))
         else:

@@ -28,7 +28,7 @@ from .similarity_exact import EXACT_TOL, fit_exact, structure_key, variants
 from .similarity_match import PERFECT, Batch, Reference, match_batch
 from .similarity_sampling import Samples, arc_fractions, element_features, sample_elements
 
-__all__ = ["detect_similarity", "symmetry_order", "terminal_name"]
+__all__ = ["detect_similarity", "symmetry_order", "terminal_name", "terminal_similarity"]
 
 #: Samples per element for voting, ICP and φ; the representative gets ``_DENSE`` times more.
 _SAMPLES = 96
@@ -66,25 +66,36 @@ def _style_key(style: str) -> str:
     return ";".join(f"{k}:{v}" for k, v in sorted(decls.items()))
 
 
-def _rotate_residual(dense: np.ndarray, normals: np.ndarray, tree: cKDTree, angle: float) -> float:
-    """Return the largest point-to-line distance of the rotated samples to the unrotated ones."""
-    x = dense * np.exp(1j * angle)
-    dist, nn = tree.query(np.column_stack([x.real, x.imag]))
+def _rotate_residuals(probe, dense, normals, tree: cKDTree, angles: np.ndarray, tol: float) -> np.ndarray:
+    """Return, per angle, the largest distance of the rotated ``probe`` from the outline of ``dense``.
+
+    Distances are point-to-line at the nearest dense sample (and at least a tenth of the
+    point distance, so a probe that lands on nothing still counts); probes farther than
+    ``20 * tol`` from every sample count as infinitely far.
+    """
+    x = (probe[None, :] * np.exp(1j * np.asarray(angles))[:, None]).ravel()
+    dist, nn = tree.query(np.column_stack([x.real, x.imag]), distance_upper_bound=20 * tol)
+    nn = np.minimum(nn, dense.size - 1)
     line = np.abs(((x - dense[nn]) * np.conj(normals[nn])).real)
-    return float(max(line.max(), 0.2 * dist.max()))
+    return np.maximum(line, 0.1 * dist).reshape(len(angles), -1).max(axis=1)
 
 
-def symmetry_order(dense: np.ndarray, normals: np.ndarray, tol: float = 4e-3) -> tuple[int, int]:
+def symmetry_order(dense: np.ndarray, normals: np.ndarray, tol: float = 0.01) -> tuple[int, int]:
     """Detect the rotational symmetry of a shape from dense samples about its centroid.
+
+    Every ``k`` up to 12 is tried by rotating a subset of the samples by ``360°/k`` and
+    measuring how far they land from the outline; higher orders (regular polygons with
+    many sides) are found from the angular moments ``mean(z**m)``, which vanish unless
+    ``k`` divides ``m``; a shape that matches itself at arbitrary angles is continuous.
 
     Parameters
     ----------
     dense : ndarray of complex
-        Arc-length uniform samples, centred on their mean and scaled to RMS radius 1.
+        Arc-length uniform samples, in order, centred on their mean and scaled to RMS radius 1.
     normals : ndarray of complex
         Unit normals at the samples.
     tol : float
-        Allowed deviation (in RMS radii) of the rotated shape from itself.
+        Largest deviation (in RMS radii) of the rotated shape from itself.
 
     Returns
     -------
@@ -93,22 +104,27 @@ def symmetry_order(dense: np.ndarray, normals: np.ndarray, tol: float = 4e-3) ->
         or more than 12-fold); ``period`` is the ``k`` to reduce pose angles by (0: any angle).
     """
     tree = cKDTree(np.column_stack([dense.real, dense.imag]))
-    ms = np.arange(2, 65)
-    mag = np.abs(dense)
+    probe = dense[:: max(1, dense.size // 96)]
+    low = np.arange(12, 1, -1)
+    generic = np.array([0.7137, 2.0911, 3.3])
+    res = _rotate_residuals(probe, dense, normals, tree, np.concatenate([generic, 2 * np.pi / low]), tol)
+    if (res[:3] < tol).all():
+        return 0, 0
+    ms = np.arange(13, 65)
+    powers = np.empty((ms.size, dense.size), complex)
+    powers[0] = dense**13
+    powers[1:] = dense
     with np.errstate(over="ignore", invalid="ignore"):
-        num = np.abs(np.mean(dense[None, :] ** ms[:, None], axis=1))
-        den = np.mean(mag[None, :] ** ms[:, None], axis=1)
+        powers = np.cumprod(powers, axis=0)  # dense ** m for every m
+        num = np.abs(powers.mean(axis=1))
+        den = np.mean(np.abs(powers), axis=1)
     strength = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
-    sig = ms[strength > 2e-3 * np.maximum(1.0, ms / 16.0)]
-    if sig.size == 0:
-        if all(_rotate_residual(dense, normals, tree, ang) < tol for ang in (0.7137, 2.0911, 3.3)):
-            return 0, 0
-        return 1, 1
-    g = int(np.gcd.reduce(sig))
-    for k in range(g, 1, -1):
-        if g % k == 0 and _rotate_residual(dense, normals, tree, 2 * np.pi / k) < tol:
-            return (k if k <= 12 else 0), k
-    return 1, 1
+    for k in ms[strength > 0.02][::-1]:  # candidate high orders, largest first
+        alone = (strength[ms % k != 0] < 0.02).all()
+        if alone and _rotate_residuals(probe, dense, normals, tree, np.array([2 * np.pi / k]), tol)[0] < tol:
+            return 0, int(k)
+    fitting = low[res[3:] < tol]
+    return (int(fitting[0]), int(fitting[0])) if fitting.size else (1, 1)
 
 
 def _canonical(a: np.ndarray, period: int) -> np.ndarray:
@@ -124,7 +140,7 @@ def _canonical(a: np.ndarray, period: int) -> np.ndarray:
     return np.abs(a) * np.exp(1j * red)
 
 
-def _sample_all(elements, fractions, cancel) -> Samples:
+def _sample_all(elements, fractions, cancel, progress=None) -> Samples:
     """Sample all elements in chunks, checking the cancel token in between.
 
     Only single open paths are sampled precisely: their poses are pinned down by arc length
@@ -136,6 +152,7 @@ def _sample_all(elements, fractions, cancel) -> Samples:
         check(cancel)
         hi = lo + 4 * _CHUNK
         parts.append(sample_elements(elements[lo:hi], fractions, precise[lo:hi]))
+        report(progress, _STAGE, 0.1 * min(hi, len(elements)) / len(elements))
     return Samples(*(np.concatenate([getattr(p, f) for p in parts]) for f in Samples.__dataclass_fields__))
 
 
@@ -221,12 +238,13 @@ class _Matcher:
         A candidate is a mirror image when it matches the flipped representative and that
         match is clearly better than the direct one, so mirror-symmetric shapes stay copies.
         """
-        test = np.flatnonzero(~ok | (gap > PERFECT))
+        test = np.flatnonzero(~ok | (gap > PERFECT) | (phi < 1.0))
         result = np.zeros(chunk.size, bool)
         if test.size == 0:
             return result
         mok, mphi, mgap, _, _ = self.match(rep, chunk[test], threshold, mirrored=True)
-        better = (mphi > phi[test] + 0.02) | ((mphi >= phi[test]) & (mgap < 0.5 * gap[test]))
+        # φ moves by a few samples with noise: only a clear margin, or a much tighter fit, counts
+        better = (mphi >= phi[test] + 0.1) | ((mphi >= phi[test] - 0.02) & (mgap < 0.5 * gap[test]))
         result[test] = mok & (~ok[test] | better)
         return result
 
@@ -276,7 +294,7 @@ def detect_similarity(
     if n == 0:
         empty = np.zeros(0, dtype=int)
         return Instancing(empty, np.zeros(0, complex), np.zeros(0, complex), (), empty, empty.copy())
-    coarse = _sample_all(elements, arc_fractions(_SAMPLES), cancel)
+    coarse = _sample_all(elements, arc_fractions(_SAMPLES), cancel, progress)
     centroid, radius, desc = element_features(coarse)
     extent = np.abs(coarse.points - centroid[:, None]).max(axis=1)
     span = np.maximum(np.abs(coarse.points).max(axis=1), 1.0)
@@ -337,10 +355,11 @@ def detect_similarity(
                 ok &= ~mirrored
             group[chunk[ok]] = g
             a[chunk[ok]], b[chunk[ok]] = pa[ok], pb[ok]
+            report(progress, _STAGE, 0.1 + 0.85 * float(np.count_nonzero(group >= 0)) / n)
         found = np.concatenate(flipped) if flipped else np.zeros(0, int)
         if found.size:
             pending.append((int(found.min()), g))
-        report(progress, _STAGE, 0.95 * float(np.count_nonzero(group >= 0)) / n)
+        report(progress, _STAGE, 0.1 + 0.85 * float(np.count_nonzero(group >= 0)) / n)
     symmetry = np.ones(len(rep_index), dtype=int)
     terminals = []
     for g, (r, rep) in enumerate(zip(rep_index, reps, strict=True)):
@@ -358,3 +377,53 @@ def detect_similarity(
         a[r], b[r] = 1.0, origin
     report(progress, _STAGE, 1.0)
     return Instancing(group, a, b, tuple(terminals), symmetry, np.array(mirror_of, dtype=int))
+
+
+def terminal_similarity(
+    terminals: tuple[Terminal, ...] | list[Terminal], *, flips: bool = True, cancel: CancelToken | None = None
+) -> np.ndarray:
+    """Return the shape similarity ``φ`` between every pair of terminals (paper §5.4).
+
+    The importance of a cluster weighs how alike its elements are; for elements of
+    different terminals that is the §4.1 similarity of their shapes, taken as the better
+    of the shape and its mirror image ("we also flip the sets") when ``flips`` is set.
+    Styles are ignored.
+
+    Parameters
+    ----------
+    terminals : sequence of Terminal
+        Terminals with SVG path data (e.g. ``Instancing.terminals``).
+    flips : bool
+        Also compare with the mirror images.
+    cancel : CancelToken, optional
+        Checked between terminals.
+
+    Returns
+    -------
+    ndarray of float, shape (k, k)
+        Symmetric, 1 on the diagonal; 0 between a drawable shape and an empty one.
+    """
+    from .svg.pathdata import cubics_from_d
+
+    k = len(terminals)
+    elements = tuple(Element(*cubics_from_d(t.path)) for t in terminals)
+    sim = np.eye(k)
+    if k < 2:
+        return sim
+    coarse = sample_elements(elements, arc_fractions(_SAMPLES))
+    centroid, radius, _ = element_features(coarse)
+    span = np.maximum(np.abs(coarse.points).max(axis=1), 1.0)
+    good = np.flatnonzero((coarse.length > 1e-9 * span) & (radius > 1e-9 * span))
+    matcher = _Matcher(elements, coarse, centroid, np.where(radius > 0, radius, 1.0))
+    for i in good:
+        check(cancel)
+        others = good[good != i]
+        if others.size == 0:
+            continue
+        rep = _Rep(elements[i], int(i), coarse)
+        _, phi, _, _, _ = matcher.match(rep, others, 1.0, mirrored=False)
+        if flips:
+            phi = np.maximum(phi, matcher.match(rep, others, 1.0, mirrored=True)[1])
+        sim[i, others] = phi
+    sim = np.maximum(sim, sim.T)
+    return sim

@@ -1,13 +1,20 @@
-"""Match a batch of candidate elements against one representative (§4.1, steps 4–7).
+"""Match a batch of candidate elements against one representative (§4.1, steps 2–7).
 
 Helpers of :mod:`lsys_core.similarity`.  Both shapes are centred on their centroids and
 normalised by their RMS radius (the paper normalises by the largest sample distance; the
-RMS radius is as cheap and steadier under resampling).  Sample pairs of similar radius and
-curvature each imply a rotation (from the normals) and a residual translation; the votes
-go into a 3D grid ``(angle, tx, ty)`` whose smoothed mode gives the transform.  It is then
-refined by batched ICP (point-to-line, closed-form least squares over the complex
-similarity) against densely sampled representative, and the similarity ``φ`` is the share
-of samples the refined transform puts on the other shape (both ways, the smaller).
+RMS radius is as cheap and steadier under resampling).
+
+1. Vote: sample pairs of similar radius and curvature each imply a rotation (from their
+   normals, both senses since the drawing direction is unknown) and a residual
+   translation; the votes go into a 3D grid ``(angle, tx, ty)`` per candidate, and the
+   peaks of the smoothed grid are the candidate transforms.
+2. Refine: batched ICP from up to three distinct peaks on a third of the samples (trimmed
+   point-to-line least squares over the complex similarity, closed form), then on all
+   samples against foot points on the representative's curves, which makes the pose of a
+   clean copy exact however it was drawn.  Open paths also pin their ends by arc length.
+3. Score: ``φ`` is the share of the candidate's samples that the transform puts on the
+   representative (within ``_INLIER`` RMS radii, normals within ~37°), or the share of the
+   representative covered by them if smaller.
 """
 
 from __future__ import annotations
@@ -31,8 +38,8 @@ _T_RANGE = 0.3
 _RADIUS_TOL = 0.06
 _CURV_TOL = 0.2
 _PAIR_CAP = 24
-_INLIER = 0.03
-_NORMAL_COS = 0.5
+_INLIER = 0.04
+_NORMAL_COS = 0.8
 _P2P_WEIGHT = 0.1
 _FAR = 1.0
 _VOTE_STRIDE = 2

@@ -171,22 +171,35 @@ def sample_elements(
 def element_features(samples: Samples) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Return centroid, RMS radius and a similarity-invariant descriptor of every element.
 
-    The descriptor is mirror-, start-point-, direction- and resampling-robust, and moves
-    little under small deformations: the deciles (10 % … 90 %) of the radial distances
-    from the centroid (normalised by the RMS radius), and the log of perimeter over RMS
-    radius (scaled down by 4).
+    The descriptor is invariant to similarities, mirroring, start point, direction and
+    resampling, and moves little under small deformations.  Its 14 entries: the deciles
+    (10 % … 90 %) of the radial distances from the centroid (normalised by the RMS radius);
+    the log of perimeter over RMS radius (divided by 4); the elongation (minor over major
+    axis of the samples' second moments); and the quartiles of ``|cos|`` of the angle
+    between normal and radius.
 
     Returns
     -------
     centroid : ndarray of complex, shape (n,)
     radius : ndarray of float, shape (n,)
-    descriptor : ndarray of float, shape (n, 10)
+    descriptor : ndarray of float, shape (n, 14)
     """
     centroid = samples.points.mean(axis=1)
-    rel = np.abs(samples.points - centroid[:, None])
+    relz = samples.points - centroid[:, None]
+    rel = np.abs(relz)
     radius = np.sqrt(np.mean(rel * rel, axis=1))
     safe = np.where(radius > 0, radius, 1.0)
-    desc = np.empty((rel.shape[0], 10))
+    desc = np.empty((rel.shape[0], 14))
     desc[:, :9] = np.quantile(rel / safe[:, None], np.linspace(0.1, 0.9, 9), axis=1).T
     desc[:, 9] = np.log1p(samples.length / safe) / 4.0
+    xx, yy, xy = (
+        (relz.real**2).mean(axis=1),
+        (relz.imag**2).mean(axis=1),
+        (relz.real * relz.imag).mean(axis=1),
+    )
+    half = (xx + yy) / 2
+    disc = np.sqrt(np.maximum(half * half - (xx * yy - xy * xy), 0.0))
+    desc[:, 10] = np.sqrt(np.maximum(half - disc, 0.0) / np.where(half + disc > 0, half + disc, 1.0))
+    cos = np.abs((samples.normals * np.conj(relz)).real) / np.maximum(rel, 1e-300)
+    desc[:, 11:] = np.quantile(np.where(rel > 0, cos, 0.0), [0.25, 0.5, 0.75], axis=1).T
     return centroid, radius, desc

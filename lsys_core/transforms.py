@@ -47,7 +47,9 @@ class PairSpace:
         return int(self.src.size)
 
 
-def pair_space(a: np.ndarray, b: np.ndarray, center: np.ndarray, radius: np.ndarray, k: int = 12) -> PairSpace:
+def pair_space(
+    a: np.ndarray, b: np.ndarray, center: np.ndarray, radius: np.ndarray, k: int = 12
+) -> PairSpace:
     """Build the directed pairs between every node and its ``k`` nearest neighbours.
 
     Parameters

@@ -67,6 +67,20 @@ IGNORED = frozenset(
 )
 
 _INTERNAL_SUBSET = re.compile(rb"<!DOCTYPE[^\[>]*\[")
+_LENGTH = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(?:px|pt|pc|mm|cm|in|em|ex|%)?\s*")
+#: An opacity declaration in a ``style`` attribute or a style sheet.
+_OPACITY_DECL = re.compile(r"(?i)((?<![\w-])(?:fill-|stroke-)?opacity\s*:\s*)([^;}!\s]+)")
+OPACITY_ATTRS = ("opacity", "fill-opacity", "stroke-opacity")
+#: Exceptions svgelements raises on values it cannot handle.
+_SVGELEMENTS_ERRORS = (
+    ValueError,
+    TypeError,
+    IndexError,
+    KeyError,
+    AttributeError,
+    ZeroDivisionError,
+    OverflowError,
+)
 
 
 @dataclass
@@ -79,6 +93,12 @@ class _Prepared:
     expected: int
     viewbox: tuple[float, float, float, float] | None
     size: tuple[str, str] | None
+    #: Why an element whose geometry comes out empty is skipped, by source index (default: degenerate).
+    reasons: dict[str, str] = field(default_factory=dict)
+    #: Warnings about attributes that were ignored (unusable viewBox, width, height).
+    notes: list[str] = field(default_factory=list)
+    #: ``(element description, transform text)`` of every element with a transform, for error messages.
+    transforms: list[tuple[str, str]] = field(default_factory=list)
 
 
 @dataclass
@@ -175,7 +195,7 @@ def parse_svg(
         elements=tuple(elements),
         viewbox=prepared.viewbox,
         size=prepared.size,
-        warnings=skips.messages(),
+        warnings=(*prepared.notes, *skips.messages()),
         source_bytes=source_bytes,
     )
 
@@ -195,6 +215,8 @@ def _maybe_gunzip(data: bytes, max_bytes: int, name: str) -> bytes:
         raise SvgError(f"not an SVG: {name}: corrupt gzip data ({exc})") from exc
     if len(out) > max_bytes or d.unconsumed_tail:
         raise LimitError(f"{name} decompresses to more than {max_bytes:,} bytes")
+    if not d.eof:
+        raise SvgError(f"not an SVG: {name}: truncated gzip data")
     return out
 
 
@@ -254,6 +276,9 @@ def _prepare(source: str | bytes, max_elements: int, max_depth: int, name: str) 
 
     names: list[str] = []
     paths: dict[str, RawPath] = {}
+    reasons: dict[str, str] = {}
+    notes: list[str] = []
+    transforms: list[tuple[str, str]] = []
     counters: dict[str, int] = {}
     ids: dict[str, ET.Element] = {}
     uses: list[ET.Element] = []
@@ -280,6 +305,9 @@ def _prepare(source: str | bytes, max_elements: int, max_depth: int, name: str) 
         el_id = el.get("id")
         if el_id is not None:
             ids[el_id] = el
+        _clamp_opacities(el, tag)
+        if tag == "svg":
+            _drop_unusable_viewport(el, notes)
         if tag in DRAWABLE or tag == "use":
             i = counters.get(tag, 0)
             counters[tag] = i + 1
@@ -287,16 +315,19 @@ def _prepare(source: str | bytes, max_elements: int, max_depth: int, name: str) 
             el.set(SRC_ATTR, key)
             names.append(f"{tag}#{el_id}" if el_id else f"{tag}[{i}]")
             if tag == "path":
-                # Parse path data here (fast); svgelements then only resolves the transform.
-                d = el.get("d")
-                raw = RawPath([], [], [], []) if d is None else raw_from_d(d)
-                if raw is not None:
-                    paths[key] = raw
-                    el.set("d", "")
+                # Parse path data here; svgelements then only resolves the transform.
+                raw, reason = _path_raw(el.get("d"))
+                paths[key] = raw
+                el.set("d", "")
+                if reason is not None:
+                    reasons[key] = reason
             if tag == "use":
                 uses.append(el)
             elif not hidden:
                 direct += 1
+        transform = el.get("transform")
+        if transform:
+            transforms.append((names[-1] if SRC_ATTR in el.attrib else f"<{tag}>", transform))
         child_hidden = hidden or tag in NOT_RENDERED or tag in USE_ONLY
         stack.extend((c, el, depth + 1, child_hidden) for c in reversed(el))
 
@@ -312,7 +343,92 @@ def _prepare(source: str | bytes, max_elements: int, max_depth: int, name: str) 
     viewbox = _parse_viewbox(root.get("viewBox"))
     w, h = root.get("width"), root.get("height")
     size = (w or "100%", h or "100%") if (w is not None or h is not None) else None
-    return _Prepared(ET.tostring(root), names, paths, expected, viewbox, size)
+    return _Prepared(ET.tostring(root), names, paths, expected, viewbox, size, reasons, notes, transforms)
+
+
+def _path_raw(d: str | None) -> tuple[RawPath, str | None]:
+    """Return the segments of path data and, if they may come out empty, why.
+
+    Data the fast parser declines (arcs, or errors) goes to svgelements, which draws
+    malformed data up to the first error as SVG asks; data it cannot read at all gives an
+    empty path with the reason ``malformed path data``.
+    """
+    if d is None:
+        return RawPath([], [], [], []), None
+    raw = raw_from_d(d)
+    if raw is not None:
+        return raw, None
+    from svgelements import Path
+
+    try:
+        path = Path(d)
+    except (*_SVGELEMENTS_ERRORS, RecursionError):
+        return RawPath([], [], [], []), "malformed path data"
+    try:
+        raw = raw_from_segments(path)
+    except _SVGELEMENTS_ERRORS:
+        return RawPath([], [], [], []), "invalid geometry"
+    has_arc = "a" in d or "A" in d
+    return raw, (None if has_arc else "malformed path data")
+
+
+def _clamp_opacity_text(text: str) -> str | None:
+    """Return ``"1"``/``"0"`` for an infinite opacity value (svgelements overflows on it), else None."""
+    try:
+        v = float(text.strip())
+    except ValueError:
+        return None
+    if math.isinf(v):
+        return "1" if v > 0 else "0"
+    return None
+
+
+def _clamp_decl(mt: re.Match) -> str:
+    fixed = _clamp_opacity_text(mt.group(2))
+    return mt.group(0) if fixed is None else mt.group(1) + fixed
+
+
+def _clamp_opacities(el, tag: str) -> None:
+    """Clamp infinite opacities in attributes, ``style`` and style sheets to [0, 1] (as CSS does)."""
+    attrib = el.attrib
+    if attrib:
+        for key in OPACITY_ATTRS:
+            value = attrib.get(key)
+            if value is not None and (fixed := _clamp_opacity_text(value)) is not None:
+                attrib[key] = fixed
+        style = attrib.get("style")
+        if style and "opacity" in style.lower():
+            attrib["style"] = _OPACITY_DECL.sub(_clamp_decl, style)
+    if tag == "style" and el.text and "opacity" in el.text.lower():
+        el.text = _OPACITY_DECL.sub(_clamp_decl, el.text)
+
+
+def _usable_length(text: str) -> bool:
+    """Tell whether a width or height is a positive, finite length."""
+    mt = _LENGTH.fullmatch(text)
+    if mt is None:
+        return False
+    v = float(mt.group(1))
+    return math.isfinite(v) and v > 0
+
+
+def _drop_unusable_viewport(el, notes: list[str]) -> None:
+    """Remove a zero, negative, non-finite or unreadable ``viewBox``, ``width`` or ``height`` of an ``<svg>``."""
+    vb = el.get("viewBox")
+    if vb is not None and _parse_viewbox(vb) is None:
+        del el.attrib["viewBox"]
+        notes.append(f"ignored the viewBox {_snippet(vb)} of <svg>: it needs 4 numbers with width, height > 0")
+    for key in ("width", "height"):
+        value = el.get(key)
+        if value is not None and not _usable_length(value):
+            del el.attrib[key]
+            notes.append(f"ignored the {key} {_snippet(value)} of <svg>: it must be a positive length")
+
+
+def _snippet(text: str, n: int = 40) -> str:
+    """Return ``text`` quoted for a message, shortened to about ``n`` characters."""
+    text = " ".join(text.split())
+    return repr(text if len(text) <= n else text[: n - 3] + "...")
 
 
 def _remove_children(pairs: list) -> None:
@@ -423,25 +539,15 @@ def _extract(prepared: _Prepared, name: str) -> tuple[list[Element], _Skips]:
 
     try:
         doc = SVG.parse(io.BytesIO(prepared.data), reify=False, parse_display_none=True)
+        vbt = doc.viewbox_transform if isinstance(doc, SVG) else ""
     except RecursionError as exc:
         raise LimitError(f"{name}: the SVG is nested too deeply to read") from exc
-    except (
-        ValueError,
-        TypeError,
-        IndexError,
-        KeyError,
-        AttributeError,
-        ZeroDivisionError,
-        OverflowError,
-    ) as exc:
-        raise SvgError(
-            f"cannot read SVG {name}: invalid attribute value ({type(exc).__name__}: {exc})"
-        ) from exc
+    except _SVGELEMENTS_ERRORS as exc:
+        raise _diagnose(prepared, name, exc) from exc
 
     # Undo the viewBox -> viewport mapping svgelements applies: keep viewBox user units.
     inverse = _IDENTITY
     vp_scale = 1.0
-    vbt = doc.viewbox_transform if isinstance(doc, SVG) else ""
     if vbt:
         m = Matrix(vbt)
         det = m.a * m.d - m.b * m.c
@@ -463,21 +569,22 @@ def _extract(prepared: _Prepared, name: str) -> tuple[list[Element], _Skips]:
             continue
         if str(values.get("visibility", "")).strip().lower() in ("hidden", "collapse"):
             continue
-        raw = prepared.paths.get(values.get(SRC_ATTR, "")) if type(shape) is Path else None
-        if raw is not None:
-            t = shape.transform
-            mat = (t.a, t.b, t.c, t.d, t.e, t.f)
-        else:
-            try:
+        key = values.get(SRC_ATTR, "")
+        raw = prepared.paths.get(key) if type(shape) is Path else None
+        try:
+            if raw is not None:
+                t = shape.transform
+                mat = (float(t.a), float(t.b), float(t.c), float(t.d), float(t.e), float(t.f))
+            else:
                 raw = raw_from_segments(shape.segments(transformed=True))
-            except (ValueError, TypeError, ZeroDivisionError, OverflowError, AttributeError):
-                skips.add("invalid geometry")
+                mat = _IDENTITY
+            if not raw.pts:
+                skips.add(prepared.reasons.get(key, "degenerate (zero size)"))
                 continue
-            mat = _IDENTITY
-        if not raw.pts:
-            skips.add("degenerate (zero size)")
+            style = _style(shape, vp_scale, opacity)
+        except _SVGELEMENTS_ERRORS:
+            skips.add("invalid geometry")
             continue
-        style = _style(shape, vp_scale, opacity)
         if style is None:
             skips.add("non-finite or huge coordinates")
             continue
@@ -520,6 +627,22 @@ def _extract(prepared: _Prepared, name: str) -> tuple[list[Element], _Skips]:
 
 
 _IDENTITY = (1.0, 0.0, 0.0, 1.0, 0.0, 0.0)
+
+
+def _diagnose(prepared: _Prepared, name: str, exc: Exception) -> SvgError:
+    """Return the error for a document svgelements failed on, naming the culprit when it can be found."""
+    from svgelements import Matrix
+
+    seen: set[str] = set()
+    for where, text in prepared.transforms:
+        if text in seen:
+            continue
+        seen.add(text)
+        try:
+            Matrix(text)
+        except (*_SVGELEMENTS_ERRORS, RecursionError):
+            return SvgError(f"cannot read SVG {name}: invalid transform {_snippet(text)} on {where}")
+    return SvgError(f"cannot read SVG {name}: invalid attribute value ({type(exc).__name__}: {exc})")
 
 
 def _compose(p: np.ndarray, q: np.ndarray) -> np.ndarray:

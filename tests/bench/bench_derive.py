@@ -14,7 +14,8 @@ from lsys_core.svg.export import export_svg
 
 HEAD = 'lsys 1\nterminal A "M0 0 C3 -5 8 -6 14 -2 C10 1 6 1 0 0 Z"\n'
 CASES = {
-    "helix P(336)": HEAD + "axiom: P(336)\nP(m): m > 0 -> A f(27.5) *(0.993) +(8.5) P(m-1)\nP(m): m == 0 -> A\n",
+    "helix P(336)": HEAD
+    + "axiom: P(336)\nP(m): m > 0 -> A f(27.5) *(0.993) +(8.5) P(m-1)\nP(m): m == 0 -> A\n",
     "helix P(999999)": HEAD + "axiom: P(999999)\nP(m): m > 0 -> A f(27.5) *(0.99999) +(8.5) P(m-1)\n"
     "P(m): m == 0 -> A\n",
     "branching R(16)": HEAD + "axiom: R(16)\nR(m): m > 0 -> A [ -(17) f(64) *(0.8) -(3) R(m-1) ] "

@@ -17,7 +17,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from scenes import grid_dims, rotating_grid_svg, write  # noqa: E402
+from scenes import grid_dims, rotating_grid_svg, write
 
 LSYS = [sys.executable, "-m", "lsys_core.cli"]
 
@@ -25,8 +25,11 @@ LSYS = [sys.executable, "-m", "lsys_core.cli"]
 def run_once(svg: Path, tmp: Path) -> tuple[float, dict, float]:
     rep = tmp / "rep.json"
     t = time.perf_counter()
-    p = subprocess.run([*LSYS, "infer", str(svg), "-o", str(tmp / "r.lsys"), "--report", str(rep)],
-                       capture_output=True, text=True)
+    p = subprocess.run(
+        [*LSYS, "infer", str(svg), "-o", str(tmp / "r.lsys"), "--report", str(rep)],
+        capture_output=True,
+        text=True,
+    )
     wall = time.perf_counter() - t
     if p.returncode:
         raise SystemExit(p.stderr)
@@ -48,8 +51,10 @@ def main() -> None:
             wall = statistics.median(r[0] for r in runs)
             rep = runs[0][1]
             stages = " ".join(f"{k}={v:.3f}" for k, v in rep["stages"].items() if k != "reproduction_error")
-            print(f"{rows * cols:>9} {wall:>10.2f} {max(r[2] for r in runs):>9.0f} {len(rep['rules']):>6}  {stages}",
-                  flush=True)
+            print(
+                f"{rows * cols:>9} {wall:>10.2f} {max(r[2] for r in runs):>9.0f} {len(rep['rules']):>6}  {stages}",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

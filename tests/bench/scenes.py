@@ -22,8 +22,11 @@ def rotating_grid_svg(rows: int, cols: int, step: float = 40.0, turn: float = 12
             d = f"M{p(0, 0)} Q{p(5, -8)} {p(14, -2)} Q{p(9, 2)} {p(0, 0)} Z"
             parts.append(f'<path fill="none" stroke="#1b5e20" d="{d}"/>')
     w, h = 40 + step * cols, 40 + step * rows
-    return (f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}">\n'
-            + "\n".join(parts) + "\n</svg>\n")
+    return (
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}">\n'
+        + "\n".join(parts)
+        + "\n</svg>\n"
+    )
 
 
 def grid_dims(n: int) -> tuple[int, int]:

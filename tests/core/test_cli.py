@@ -42,7 +42,18 @@ def test_infer_writes_rules_svg_and_report(tmp_path) -> None:
 def test_derive_set_and_randomize(tmp_path) -> None:
     rules = ROOT / "tests" / "data" / "helix_truth.lsys"
     out = tmp_path / "o.svg"
-    p = run("derive", str(rules), "-o", str(out), "--set", "axiom.0.3.m=9", "--randomize", "angle=3", "--seed", "4")
+    p = run(
+        "derive",
+        str(rules),
+        "-o",
+        str(out),
+        "--set",
+        "axiom.0.3.m=9",
+        "--randomize",
+        "angle=3",
+        "--seed",
+        "4",
+    )
     assert p.returncode == 0, p.stderr
     assert out.read_text().count("<path") == 10
     params = run("params", str(rules)).stdout

@@ -13,7 +13,9 @@ from .scenes import HOOK, LEAF, place, pose, scene, turtle_sequence
 
 
 def turtle_values(g, op):
-    return [m.value.c0 for r in g.rules for c in r.cases for m in c.body if isinstance(m, Turtle) and m.op == op]
+    return [
+        m.value.c0 for r in g.rules for c in r.cases for m in c.body if isinstance(m, Turtle) and m.op == op
+    ]
 
 
 def check_reproduces(result, sc) -> None:
@@ -47,14 +49,19 @@ def test_helix_recovers_scale_and_angle() -> None:
     assert any(abs(s - 0.99) < 0.99e-3 or abs(1 / s - 0.99) < 0.99e-3 for s in scales)
     # The relative rotation per step is 11° (α + β), within 0.1°.
     rule = r.grammar.rules[0]
-    turns = [m.value.c0 * (1 if m.op == "+" else -1) for m in rule.cases[0].body if isinstance(m, Turtle)
-             and m.op in "+-"]
+    turns = [
+        m.value.c0 * (1 if m.op == "+" else -1)
+        for m in rule.cases[0].body
+        if isinstance(m, Turtle) and m.op in "+-"
+    ]
     assert abs(abs(((sum(turns) + 180) % 360) - 180) - 11) < 0.1
 
 
 def test_ring_is_one_sequence() -> None:
-    frames = [pose(200 + 60 * np.cos(t), 200 + 60 * np.sin(t), np.rad2deg(t) + 90) for t in
-              np.linspace(0, 2 * np.pi, 12, endpoint=False)]
+    frames = [
+        pose(200 + 60 * np.cos(t), 200 + 60 * np.sin(t), np.rad2deg(t) + 90)
+        for t in np.linspace(0, 2 * np.pi, 12, endpoint=False)
+    ]
     sc = scene(place(HOOK, frames))
     r = infer(sc)
     check_reproduces(r, sc)
@@ -111,8 +118,10 @@ def test_resegmented_copy_shares_terminal() -> None:
         return [[p0, q0, r0, s], [s, r1, q2, p3]]
 
     fine = np.array([seg for c in LEAF for seg in split(c)])
-    sc = scene(place(LEAF, [pose(20 + 40 * i, 20) for i in range(3)]),
-               place(fine, [pose(140 + 40 * i, 20) for i in range(3)]))
+    sc = scene(
+        place(LEAF, [pose(20 + 40 * i, 20) for i in range(3)]),
+        place(fine, [pose(140 + 40 * i, 20) for i in range(3)]),
+    )
     r = infer(sc)
     assert len(r.grammar.terminals) == 1
     check_reproduces(r, sc)
@@ -124,8 +133,13 @@ def test_rotating_row_uses_linear_parameters() -> None:
     r = infer(sc)
     check_reproduces(r, sc)
     assert r.grammar.production_count == 2
-    deltas = [m.value.cd for rule in r.grammar.rules for c in rule.cases for m in c.body
-              if isinstance(m, Turtle) and m.value.cd]
+    deltas = [
+        m.value.cd
+        for rule in r.grammar.rules
+        for c in rule.cases
+        for m in c.body
+        if isinstance(m, Turtle) and m.value.cd
+    ]
     assert any(abs(abs(d) - 12) < 0.1 for d in deltas)
 
 
@@ -155,7 +169,9 @@ def test_clutter_is_never_lost() -> None:
 
 def test_symmetrize_regularises_jitter() -> None:
     rng = np.random.default_rng(1)
-    frames = [pose(20 + 25 * i + rng.normal(0, 0.6), 50 + rng.normal(0, 0.6), rng.normal(0, 1.5)) for i in range(30)]
+    frames = [
+        pose(20 + 25 * i + rng.normal(0, 0.6), 50 + rng.normal(0, 0.6), rng.normal(0, 1.5)) for i in range(30)
+    ]
     sc = scene(place(LEAF, frames))
     r = symmetrize(sc)
     d = derive(r.grammar)

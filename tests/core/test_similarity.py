@@ -11,7 +11,7 @@ import pytest
 from lsys_core.cancel import CancelToken
 from lsys_core.errors import Cancelled, InferenceError
 from lsys_core.model import Element, Scene
-from lsys_core.similarity import detect_similarity, symmetry_order, terminal_name
+from lsys_core.similarity import detect_similarity, symmetry_order, terminal_name, terminal_similarity
 from lsys_core.similarity_sampling import arc_fractions, element_features, sample_elements
 
 CORPUS = Path("/work/shared/corpus")
@@ -376,3 +376,64 @@ def test_corpus_mirrored_has_a_shape_and_its_mirror():
     assert inst.mirrored_of.tolist() == [-1, 0]
     assert inst.terminals[1].mirror_of == inst.terminals[0].name
     assert np.bincount(inst.group).tolist() == [10, 10]
+
+
+def test_noisy_copies_group_without_a_spurious_mirror():
+    comma = np.array([[0, 10 - 8j, 30 - 6j, 40], [40, 25 + 2j, 10 + 4j, 0]])  # no symmetry at all
+    rng = np.random.default_rng(21)
+    a, b = random_poses(16, seed=22)
+    els = [el(a[0] * comma + b[0])]
+    for i in range(1, 16):
+        noisy = comma + 0.4 * (
+            rng.normal(size=comma.shape) + 1j * rng.normal(size=comma.shape)
+        )  # 1 % of size
+        noisy[1:, 0] = noisy[:-1, 3]
+        noisy[0, 0] = noisy[-1, 3]
+        els.append(el(a[i] * split(noisy) + b[i]))
+    inst = detect_similarity(Scene(tuple(els)))
+    assert inst.group.tolist() == [0] * 16
+    assert inst.mirrored_of.tolist() == [-1]
+    assert np.abs(np.angle(inst.a / (a / a[0]), deg=True)).max() < 2.0
+
+
+def test_open_arc_poses_are_pinned_down_by_arc_length():
+    arc = np.array([[1, 1 + K * 1j, K + 1j, 1j], [1j, -K + 1j, -1 + K * 1j, -1]])  # half circle
+    a, b = random_poses(8, seed=13)
+    els = [el(a[i] * (split(arc, 0.37) if i % 2 else reverse(arc)) + b[i], closed=False) for i in range(8)]
+    inst = detect_similarity(Scene(tuple(els)))
+    assert inst.group.tolist() == [0] * 8
+    assert inst.symmetry.tolist() == [1]
+    assert_poses(inst, np.arange(8), a, b, 2.0)
+
+
+def test_terminal_similarity_counts_mirror_images_as_alike():
+    tri = lines([0, 14, 10 + 5j])  # scalene
+    inst = detect_similarity(Scene((el(LEAF), el(np.conj(LEAF)), el(tri), el(np.conj(tri)))))
+    assert [t.name for t in inst.terminals] == ["A", "B", "C", "D"]
+    sim = terminal_similarity(inst.terminals)
+    assert np.allclose(sim, sim.T) and np.allclose(np.diag(sim), 1)
+    assert sim[0, 1] > 0.95 and sim[2, 3] > 0.95
+    assert sim[0, 2] < 0.6 and sim[1, 3] < 0.6
+    plain = terminal_similarity(inst.terminals, flips=False)
+    assert plain[2, 3] < sim[2, 3] - 0.2  # without flips a mirror image is only partly alike
+
+
+def test_cancel_from_progress_callback_stops_the_run():
+    token = CancelToken()
+    els = (*(el(LEAF * (1 + 0.01 * i) + 50 * i) for i in range(20)), el(lines([0, 14, 10 + 5j])))
+
+    def progress(stage: str, fraction: float) -> None:
+        if fraction > 0:
+            token.cancel()
+
+    with pytest.raises(Cancelled):
+        detect_similarity(Scene(els), cancel=token, progress=progress)
+
+
+def test_many_sided_polygon_reports_continuous_but_keeps_its_true_period():
+    poly = lines([np.exp(2j * np.pi * k / 16) for k in range(16)])
+    els = (el(10 * poly), el(20 * np.exp(np.deg2rad(30) * 1j) * poly + 100))
+    inst = detect_similarity(Scene(els))
+    assert inst.group.tolist() == [0, 0]
+    assert inst.symmetry.tolist() == [0]
+    assert np.isclose(np.angle(inst.a[1], deg=True), 7.5) and np.isclose(abs(inst.a[1]), 2)

@@ -275,7 +275,8 @@ def test_degenerate_elements_are_skipped_with_warning():
     scene = parse_svg(text)
     assert [e.source for e in scene.elements] == ["rect[1]"]
     warnings = " | ".join(scene.warnings)
-    assert "skipped 6 elements: degenerate (zero size)" in warnings
+    assert "skipped 5 elements: degenerate (zero size)" in warnings
+    assert "skipped 1 element: malformed path data" in warnings  # Lnan
     assert "skipped 2 elements: non-finite or huge coordinates" in warnings
 
 
