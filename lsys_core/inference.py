@@ -296,12 +296,17 @@ def _size_of(bld: _Builder, sym: np.ndarray, nodes: np.ndarray) -> np.ndarray:
 
 
 def _proximity(ps: PairSpace, n_nodes: int, radius: np.ndarray) -> np.ndarray:
-    """Per-pair proximity in (0, 1]: 1 for a node's nearest neighbour, lower for farther pairs."""
+    """Per-pair proximity in (0, 1]: 1 for a node's nearest neighbour, lower for farther pairs.
+
+    Distances are between the centres of the nodes' geometry, relative to the nearest
+    neighbour of either node; neighbours up to :data:`NEAR_BAND` times farther than the
+    nearest count as equally near (spacings that differ a little look alike).
+    """
     nn = np.full(n_nodes, np.inf)
-    np.minimum.at(nn, ps.src, ps.gap)
-    eps = 0.05 * float(np.median(radius)) + 1e-12
+    np.minimum.at(nn, ps.src, ps.dist)
+    eps = 0.1 * float(np.median(radius)) + 1e-12
     near = np.minimum(nn[ps.src], nn[ps.dst])
-    return (near + eps) / (ps.gap + eps)
+    return np.minimum(NEAR_BAND * (near + eps) / (ps.dist + eps), 1.0)
 
 
 def _candidates(bld: _Builder, sym, a, b, ps: PairSpace, radius: np.ndarray) -> list[_Candidate]:
@@ -338,8 +343,7 @@ def _candidates(bld: _Builder, sym, a, b, ps: PairSpace, radius: np.ndarray) -> 
         A, B = _mean_rel(ps.A[used], ps.B[used])
         lengths = [len(c) - 1 for c in chains]
         rep = len(chains) >= 2 or max(lengths) >= 2
-        if si == sj:
-            seq_by_space.setdefault((si, sj), []).append((idx, succ))
+        seq_by_space.setdefault((si, sj), []).append((idx, succ))
         if not rep:
             continue
         kind = "seq" if si == sj and max(lengths) >= 2 else "pair"
@@ -351,10 +355,41 @@ def _candidates(bld: _Builder, sym, a, b, ps: PairSpace, radius: np.ndarray) -> 
         cand.h = float(np.mean(prox[used]))
         cand.phi = bld.phi(si, sj)
         cand.l = float(np.mean(lengths))
+        if kind == "pair" and si != sj:
+            cand.extra["succ"] = succ
         out.append(cand)
-    out += _branch_candidates(bld, ps, seq_by_space, prox, a.size)
+    _alternation_lengths(out, seq_by_space)
+    out += _branch_candidates(bld, ps, {k: v for k, v in seq_by_space.items() if k[0] == k[1]}, prox, a.size)
     out += _linear_candidates(bld, sym, ps, prox, size, key)
     return out
+
+
+def _alternation_lengths(cands: list[_Candidate], clusters: dict) -> None:
+    """Give pair candidates A→B the length of the alternating sequences A B A B … they start.
+
+    When a cluster of B→A pairs links each pair's B to the A of the next pair, the pairs
+    are the steps of one sequence ``A T B T' A T B …``: merging them first lets the next
+    level code it with a single sequence rule.
+    """
+    for c in cands:
+        succ = c.extra.get("succ")
+        if succ is None:
+            continue
+        si, sj = c.space
+        best = 1.0
+        for _, back in clusters.get((sj, si), [])[:4]:
+            targets = set(back.values())
+            lengths = []
+            for x in (x for x in succ if x not in targets):
+                n, cur, seen = 0, x, set()
+                while cur in succ and cur not in seen:
+                    seen.add(cur)
+                    n += 1
+                    cur = back.get(succ[cur], -1)
+                lengths.append(n)
+            if lengths:
+                best = max(best, float(np.mean(lengths)))
+        c.l = best
 
 
 def _group_indices(labels: np.ndarray) -> list[np.ndarray]:
@@ -468,6 +503,8 @@ def _tree_nodes(root: int, depth: int, c1: np.ndarray, c2: np.ndarray) -> np.nda
     return out if np.unique(out).size == out.size and (out >= 0).all() else None
 
 
+#: Pairs up to this factor farther apart than a node's nearest neighbour have proximity 1.
+NEAR_BAND = 1.25
 #: Step clusters (Δα, Δβ) examined per (d, s) cluster, largest first: smaller ones cannot win.
 _STEP_CLUSTERS = 12
 

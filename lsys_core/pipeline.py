@@ -116,6 +116,15 @@ def _shape_similarity(inst: Instancing, cancel: CancelToken | None) -> np.ndarra
     return terminal_similarity(inst.terminals, cancel=cancel)
 
 
+def description_size(g: Grammar) -> int:
+    """Size of a grammar's rules: modules in all productions and the axiom, plus one per production.
+
+    Used to compare grammars found at different tolerances: a rule that merely lists the
+    nodes no repetition explains is as large as what it lists.
+    """
+    return len(g.axiom) + sum(1 + len(c.body) for r in g.rules for c in r.cases)
+
+
 def _diagonal(center: np.ndarray, radius: np.ndarray) -> float:
     lo = np.array([np.min(center.real - radius), np.min(center.imag - radius)])
     hi = np.array([np.max(center.real + radius), np.max(center.imag + radius)])
@@ -182,9 +191,9 @@ def infer(
     -----
     If the rules found at the user's tolerance leave elements unexplained by any
     repetition, the clustering is relaxed (×3 … ×15) and the grammar with the fewest
-    productions is kept among those that deviate at most :data:`INFER_ERROR` from the
-    input, or at most :data:`JITTER_ERROR` when they need clearly fewer productions
-    (a jittered pattern).
+    rules (:func:`description_size`) is kept among those that deviate at most
+    :data:`INFER_ERROR` from the input, or at most :data:`JITTER_ERROR` when they are
+    clearly smaller (a jittered pattern).
 
     Returns
     -------
@@ -246,14 +255,14 @@ def infer(
             reproduction_error(inst, sizes, derive(grammar, limit=max(10 * len(scene.elements), 1000))) / diag
         )
         stages["postprocess"] = stages.get("postprocess", 0.0) + time.perf_counter() - t
-        count = grammar.production_count
+        count = description_size(grammar)
         if best is None:
             ok = True
         elif symmetrizing:
             ok = error <= SYMMETRIZE_ERROR
         else:
             ok = error <= INFER_ERROR or (error <= JITTER_ERROR and count <= JITTER_GAIN * first_count)
-        if ok and (best is None or (count, error) < (best[0].production_count, best[2])):
+        if ok and (best is None or (count, error) < (description_size(best[0]), best[2])):
             best = (grammar, hier, error)
         if best is not None and first_count is None:
             first_count = count

@@ -29,6 +29,8 @@ class PairSpace:
         Relative frame of ``dst`` seen from ``src`` (:func:`lsys_core.geometry.relative`).
     alpha, d, s, beta : ndarray of float
         The paper's ``+(alpha) f(d) *(s) +(beta)`` (degrees).
+    dist : ndarray of float
+        Distance between the centres of the two nodes' covered geometry.
     gap : ndarray of float
         Distance between the two nodes' outlines (bounding-circle approximation, >= 0).
     """
@@ -41,6 +43,7 @@ class PairSpace:
     d: np.ndarray
     s: np.ndarray
     beta: np.ndarray
+    dist: np.ndarray
     gap: np.ndarray
 
     def __len__(self) -> int:
@@ -69,7 +72,7 @@ def pair_space(
     if n < 2:
         e = np.zeros(0, int)
         z = np.zeros(0)
-        return PairSpace(e, e, z.astype(complex), z.astype(complex), z, z, z, z, z)
+        return PairSpace(e, e, z.astype(complex), z.astype(complex), z, z, z, z, z, z)
     kk = min(k, n - 1)
     pts = np.column_stack([center.real, center.imag])
     _, idx = cKDTree(pts).query(pts, k=kk + 1)
@@ -85,5 +88,6 @@ def pair_space(
     A = a[dst] / a[src]
     B = (b[dst] - b[src]) / a[src]
     alpha, d, s, beta = t4_from_rel(A, B)
-    gap = np.maximum(np.abs(center[dst] - center[src]) - radius[src] - radius[dst], 0.0)
-    return PairSpace(src, dst, A, B, alpha, d, s, beta, gap)
+    dist = np.abs(center[dst] - center[src])
+    gap = np.maximum(dist - radius[src] - radius[dst], 0.0)
+    return PairSpace(src, dst, A, B, alpha, d, s, beta, dist, gap)

@@ -67,7 +67,8 @@ IGNORED = frozenset(
 )
 
 _INTERNAL_SUBSET = re.compile(rb"<!DOCTYPE[^\[>]*\[")
-_LENGTH = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(?:px|pt|pc|mm|cm|in|em|ex|%)?\s*")
+#: A canvas width or height svgelements can resolve (no font-relative units: the root has no font).
+_LENGTH = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(?:px|pt|pc|mm|cm|in|%)?\s*")
 #: An opacity declaration in a ``style`` attribute or a style sheet.
 _OPACITY_DECL = re.compile(r"(?i)((?<![\w-])(?:fill-|stroke-)?opacity\s*:\s*)([^;}!\s]+)")
 OPACITY_ATTRS = ("opacity", "fill-opacity", "stroke-opacity")
@@ -373,13 +374,15 @@ def _path_raw(d: str | None) -> tuple[RawPath, str | None]:
 
 
 def _clamp_opacity_text(text: str) -> str | None:
-    """Return ``"1"``/``"0"`` for an infinite opacity value (svgelements overflows on it), else None."""
+    """Return an opacity number outside [0, 1] clamped into it (svgelements overflows on huge ones), else None."""
     try:
         v = float(text.strip())
     except ValueError:
         return None
-    if math.isinf(v):
-        return "1" if v > 0 else "0"
+    if v > 1.0:
+        return "1"
+    if v < 0.0:
+        return "0"
     return None
 
 
@@ -422,7 +425,7 @@ def _drop_unusable_viewport(el, notes: list[str]) -> None:
         value = el.get(key)
         if value is not None and not _usable_length(value):
             del el.attrib[key]
-            notes.append(f"ignored the {key} {_snippet(value)} of <svg>: it must be a positive length")
+            notes.append(f"ignored the {key} {_snippet(value)} of <svg>: it must be a positive length in px, pt, pc, mm, cm, in or %")
 
 
 def _snippet(text: str, n: int = 40) -> str:
@@ -600,7 +603,7 @@ def _extract(prepared: _Prepared, name: str) -> tuple[list[Element], _Skips]:
     full = _compose(np.array(inverse, dtype=float), np.array(mats, dtype=float).reshape(-1, 6))
     cubics = _apply(cubics, np.repeat(full, counts, axis=0))
     starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore", over="ignore"):
         seg_ok = np.isfinite(cubics).all(axis=1) & (np.abs(cubics).max(axis=1) <= MAX_COORD)
         bad = np.add.reduceat((~seg_ok).astype(np.intp), starts) > 0
         first = cubics[starts, 0]
@@ -642,24 +645,49 @@ def _diagnose(prepared: _Prepared, name: str, exc: Exception) -> SvgError:
             Matrix(text)
         except (*_SVGELEMENTS_ERRORS, RecursionError):
             return SvgError(f"cannot read SVG {name}: invalid transform {_snippet(text)} on {where}")
-    return SvgError(f"cannot read SVG {name}: invalid attribute value ({type(exc).__name__}: {exc})")
+    detail = str(exc).strip() or type(exc).__name__
+    where = _failing_element(exc, prepared.names)
+    at = f" on {where}" if where else ""
+    return SvgError(f"cannot read SVG {name}: invalid attribute value{at} ({_snippet(detail, 80)[1:-1]})")
+
+
+def _failing_element(exc: BaseException, names: list[str]) -> str | None:
+    """Describe the element svgelements was reading when it failed (from its parse loop's frame), if known."""
+    tb = exc.__traceback__
+    found = None
+    while tb is not None:
+        frame = tb.tb_frame
+        if frame.f_code.co_name == "parse" and "svgelements" in frame.f_code.co_filename:
+            elem = frame.f_locals.get("elem")
+            if elem is not None and hasattr(elem, "attrib"):
+                found = elem
+        tb = tb.tb_next
+    if found is None:
+        return None
+    key = found.attrib.get(SRC_ATTR)
+    if key is not None and key.isdigit() and int(key) < len(names):
+        return names[int(key)]
+    tag = _local(found.tag) or "?"
+    el_id = found.attrib.get("id")
+    return f"<{tag}{f' id={_snippet(el_id, 20)}' if el_id else ''}>"
 
 
 def _compose(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Return the affine matrices ``p @ q`` in SVG ``(a, b, c, d, e, f)`` order; ``q`` is ``(n, 6)``."""
     pa, pb, pc, pd, pe, pf = p
     qa, qb, qc, qd, qe, qf = q.T
-    return np.stack(
-        [
-            pa * qa + pc * qb,
-            pb * qa + pd * qb,
-            pa * qc + pc * qd,
-            pb * qc + pd * qd,
-            pa * qe + pc * qf + pe,
-            pb * qe + pd * qf + pf,
-        ],
-        axis=1,
-    )
+    with np.errstate(invalid="ignore", over="ignore"):  # non-finite results are skipped later
+        return np.stack(
+            [
+                pa * qa + pc * qb,
+                pb * qa + pd * qb,
+                pa * qc + pc * qd,
+                pb * qc + pd * qd,
+                pa * qe + pc * qf + pe,
+                pb * qe + pd * qf + pf,
+            ],
+            axis=1,
+        )
 
 
 def _apply(cubics: np.ndarray, mats: np.ndarray) -> np.ndarray:

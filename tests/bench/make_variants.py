@@ -235,11 +235,12 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("out")
     ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--first", type=int, default=0, help="first seed offset")
     a = ap.parse_args()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     for seed in range(a.seeds):
-        rng = np.random.default_rng(1000 + seed)
+        rng = np.random.default_rng(1000 + a.first + seed)
         for kind, items, mode, truth in kinds(rng):
             write_scene(out, f"{kind}_{seed}", items, mode, truth, rng)
 

@@ -1,0 +1,236 @@
+"""Benchmark the editor's responsiveness (run it, it is not a test).
+
+    QT_QPA_PLATFORM=offscreen python tests/bench/bench_editor.py [--json OUT.json] [--quick]
+
+Reports, in milliseconds:
+
+* parameter slider → repainted canvas, for 10,000 and 100,000 elements: while dragging
+  (draft frames; target ≤ 16 ms for 10,000 and ≤ 250 ms for 100,000) and after the release
+  (full anti-aliased quality; target ≤ 100 ms for 10,000).  Each move is timed from
+  ``QSlider.setValue`` on the UI thread to the end of a synchronous ``repaint()`` that shows
+  the frame of the new value.
+* the longest UI-thread stall while inference of a 1,200-element scene runs in the background,
+  with inference in a worker thread and in a worker process: a 2 ms QTimer on the UI thread
+  records the gaps between its ticks (a stall is a gap minus the 2 ms period).
+
+Scenes are derived from grammars and exported with ``lsys_core`` into a temporary folder.
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import os
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+
+LEAF = '"M 0 0 Q 5 -8 14 -2 Q 9 2 0 0 Z" style "fill:#66bb6a;stroke:#1b5e20;stroke-width:0.6"'
+
+
+def grid_grammar(
+    rows: int, cols: int, step: float = 16.0, bend: float = 0.2, gap: float | None = None
+) -> str:
+    """Return .lsys text of ``rows`` × ``cols`` leaves, each row curved by ``bend`` degrees a step."""
+    gap = step if gap is None else gap
+    return (
+        f"lsys 1\nterminal A {LEAF}\naxiom: Q({rows - 1})\n"
+        f"P(m): m > 0 -> A f({step}) +({bend}) P(m-1)\nP(m): m == 0 -> A\n"
+        f"Q(m): m > 0 -> [ P({cols - 1}) ] +(90) f({gap}) -(90) Q(m-1)\nQ(m): m == 0 -> P({cols - 1})\n"
+    )
+
+
+def wait_until(app, cond, timeout: float = 60.0, signals=()) -> None:
+    """Run the event loop until ``cond()`` holds: checked when one of ``signals`` fires, and
+    every 5 ms in case none does."""
+    from PySide6.QtCore import QEventLoop, Qt, QTimer
+
+    if cond():
+        return
+    loop = QEventLoop()
+    timer = QTimer()
+    timer.setInterval(5)
+    deadline = time.perf_counter() + timeout
+
+    def check(*_args) -> None:
+        if cond() or time.perf_counter() > deadline:
+            loop.quit()
+
+    timer.timeout.connect(check)
+    for signal in signals:
+        signal.connect(check, type=Qt.ConnectionType.QueuedConnection)
+    timer.start()
+    loop.exec()
+    timer.stop()
+    for signal in signals:
+        signal.disconnect(check)
+    if not cond():
+        raise TimeoutError("condition not reached")
+
+
+def make_window(**kwargs):
+    from PySide6.QtCore import QSettings
+
+    from app.main_window import MainWindow
+
+    settings = QSettings(os.path.join(tempfile.gettempdir(), "lsys-bench.ini"), QSettings.Format.IniFormat)
+    win = MainWindow(settings, restore_layout=False, autosave=False, **kwargs)
+    win.resize(1400, 900)
+    win.show()
+    return win
+
+
+def frame_ready(win) -> bool:
+    """Whether the canvas holds a frame of the document's current drawing, nothing pending."""
+    doc, canvas = win.doc, win.canvas
+    return (
+        not doc.busy
+        and not canvas.runner.busy
+        and canvas._frame is not None
+        and canvas._frame.drawing is canvas._shown
+        and canvas.drawing is doc.drawing
+    )
+
+
+def bench_slider(app, workdir: Path, rows: int, cols: int, moves: int) -> dict:
+    """Time slider moves while dragging (drafts) and the full-quality frame after release."""
+    path = workdir / f"grid-{rows}x{cols}.lsys"
+    path.write_text(grid_grammar(rows, cols), encoding="utf-8")
+    win = make_window()
+    win.open_path(str(path))
+    wait_until(app, win.is_idle)
+    n = len(win.doc.drawing)
+    row = win.params_panel.rows["P.0.2.v"]  # the +(0.2) bend of every row
+    drag, derive_ms, render_ms, full = [], [], [], []
+    for _ in range(3):  # repeat whole gestures; the first warms caches up
+        row.slider.setSliderDown(True)
+        start = row.slider.value()
+        for k in range(1, moves + 1):
+            t0 = time.perf_counter()
+            row.slider.setValue(start + 3 * k)
+            wait_until(app, lambda: frame_ready(win), signals=(win.canvas.runner.resultReady,))
+            win.canvas.repaint()
+            drag.append((time.perf_counter() - t0) * 1e3)
+            render_ms.append(win.canvas.last_frame_seconds * 1e3)
+            assert win.canvas._frame.draft
+        t0 = time.perf_counter()
+        row.slider.setSliderDown(False)
+        wait_until(app, win.is_idle)
+        win.canvas.repaint()
+        full.append((time.perf_counter() - t0) * 1e3)
+        assert not win.canvas._frame.draft
+        win.doc.undo_stack.undo()
+        wait_until(app, win.is_idle)
+    t0 = time.perf_counter()
+    from lsys_core.derive import derive
+
+    for _ in range(5):
+        derive(win.doc.grammar)
+    derive_ms.append((time.perf_counter() - t0) / 5 * 1e3)
+    win.doc.undo_stack.setClean()
+    win.close()
+    drag = drag[moves:]  # drop the warm-up gesture
+    return {
+        "elements": n,
+        "drag_median_ms": statistics.median(drag),
+        "drag_p90_ms": sorted(drag)[int(0.9 * (len(drag) - 1))],
+        "draft_render_median_ms": statistics.median(render_ms[moves:]),
+        "derive_ms": derive_ms[0],
+        "release_to_full_quality_ms": statistics.median(full[1:]),
+    }
+
+
+def bench_stall(app, workdir: Path, in_process: bool, seconds: float) -> dict:
+    """Longest gap of a 2 ms UI timer while a 1,200-element scene is inferred in the background."""
+    from PySide6.QtCore import QTimer
+
+    from app.jobs import run_inference
+    from lsys_core.derive import derive
+    from lsys_core.grammar import parse_grammar
+    from lsys_core.svg.export import export_svg
+
+    svg = workdir / "scene1200.svg"
+    if not svg.exists():
+        # curved rows: a scene whose inference takes long enough to watch (tens of seconds)
+        export_svg(derive(parse_grammar(grid_grammar(30, 40, step=20.0, bend=3.0, gap=25.0))), svg)
+    win = make_window(**({} if in_process else {"infer_compute": run_inference}))
+    if in_process:
+        win.doc._infer_compute.start()
+        time.sleep(1.5)  # let the process finish its imports, as it does while the window opens
+    ticks: list[float] = []
+    timer = QTimer()
+    timer.setInterval(2)
+    timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
+    t_open = time.perf_counter()
+    win.open_path(str(svg))
+    timer.start()
+    try:
+        wait_until(app, lambda: not win.doc.inference.busy, timeout=seconds)
+        finished = True
+    except TimeoutError:
+        finished = False
+    elapsed = time.perf_counter() - t_open
+    t_cancel = time.perf_counter()
+    win.doc.cancel_inference()
+    wait_until(app, lambda: not win.doc.inference.busy, timeout=30)
+    cancel_s = time.perf_counter() - t_cancel
+    timer.stop()
+    gaps = [(b - a) * 1e3 - 2.0 for a, b in itertools.pairwise(ticks)]
+    win.close()
+    return {
+        "mode": "process" if in_process else "thread",
+        "elements": 1200,
+        "observed_s": round(elapsed, 2),
+        "inference_finished": finished,
+        "max_stall_ms": max(gaps) if gaps else float("nan"),
+        "p99_stall_ms": sorted(gaps)[int(0.99 * (len(gaps) - 1))] if gaps else float("nan"),
+        "ticks": len(ticks),
+        "cancel_s": round(cancel_s, 3),
+    }
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--json", help="also write the figures to this file")
+    parser.add_argument("--quick", action="store_true", help="fewer moves and a shorter inference window")
+    parser.add_argument("--stall-seconds", type=float, default=20.0, help="longest inference observed")
+    args = parser.parse_args(argv)
+    from PySide6.QtWidgets import QApplication
+
+    app = QApplication.instance() or QApplication([])
+    moves = 5 if args.quick else 12
+    out: dict = {"slider": [], "stall": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        for rows, cols in ((100, 100), (250, 400)):
+            r = bench_slider(app, work, rows, cols, moves)
+            out["slider"].append(r)
+            print(
+                f"{r['elements']:>7,} elements: drag {r['drag_median_ms']:.1f} ms median "
+                f"(p90 {r['drag_p90_ms']:.1f}; draft render {r['draft_render_median_ms']:.1f}, "
+                f"derive {r['derive_ms']:.1f}), release → full quality {r['release_to_full_quality_ms']:.1f} ms",
+                flush=True,
+            )
+        seconds = 8.0 if args.quick else args.stall_seconds
+        for in_process in (False, True):
+            r = bench_stall(app, work, in_process, seconds)
+            out["stall"].append(r)
+            print(
+                f"inference of 1,200 elements in a {r['mode']:7s}: longest UI stall {r['max_stall_ms']:.1f} ms, "
+                f"p99 {r['p99_stall_ms']:.1f} ms over {r['observed_s']} s "
+                f"({'finished' if r['inference_finished'] else 'still running'}; cancel took {r['cancel_s']} s)",
+                flush=True,
+            )
+    if args.json:
+        Path(args.json).write_text(json.dumps(out, indent=1), encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
