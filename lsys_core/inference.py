@@ -104,22 +104,37 @@ def _t_modules(alpha: Linear, d: Linear, s: Linear, beta: Linear) -> tuple[Modul
     def angle(v: Linear) -> None:
         c0 = float(wrap_deg(v.c0)) if v.cd == 0 else v.c0
         if abs(c0) > 1e-9 or v.cd != 0:
-            out.append(Turtle("+", Linear(_r(c0), _r(v.cd))))
+            out.append(Turtle("+", Linear(_nice(c0, abs_tol=ANGLE_SNAP), _nice(v.cd, abs_tol=ANGLE_SNAP))))
 
     angle(alpha)
     if abs(d.c0) > 1e-12 or d.cd != 0:
-        out.append(Turtle("f", Linear(_r(d.c0), _r(d.cd))))
+        out.append(
+            Turtle("f", Linear(_nice(d.c0, rel_tol=DISTANCE_SNAP), _nice(d.cd, rel_tol=DISTANCE_SNAP)))
+        )
     if abs(s.c0 - 1.0) > 1e-9 or s.cd != 0:
-        out.append(Turtle("*", Linear(_r(s.c0), _r(s.cd))))
+        out.append(Turtle("*", Linear(_nice(s.c0, rel_tol=SCALE_SNAP), _nice(s.cd, rel_tol=SCALE_SNAP))))
     angle(beta)
     return tuple(out)
 
 
-def _r(x: float) -> float:
-    """Round to 9 significant digits (keeps the text short, far below drawing precision)."""
+#: Written values are the shortest decimals within these tolerances of the measured ones
+#: (degrees; relative for distances and scales, which compound along a sequence).
+ANGLE_SNAP = 1e-5
+DISTANCE_SNAP = 1e-6
+SCALE_SNAP = 1e-8
+
+
+def _nice(x: float, *, abs_tol: float = 0.0, rel_tol: float = 0.0) -> float:
+    """Return the decimal with the fewest digits within the tolerance of ``x`` (``45.0000049`` → ``45``)."""
+    x = float(x)
     if x == 0 or not np.isfinite(x):
-        return 0.0 if x == 0 else float(x)
-    return float(f"{x:.9g}") + 0.0
+        return 0.0 if x == 0 else x
+    tol = max(abs_tol, rel_tol * abs(x))
+    for digits in range(0, 12):
+        y = round(x, digits)
+        if abs(y - x) <= tol:
+            return y + 0.0
+    return float(f"{x:.12g}") + 0.0
 
 
 def _const_t(A: complex, B: complex) -> tuple[Module, ...]:
@@ -248,6 +263,9 @@ def build_hierarchy(
         cands = _candidates(bld, sym, a, b, ps, radius)
         t2 = time.perf_counter()
         if cands:
+            first = np.array([m.min() for m in members])
+            for c in cands:
+                c.extra["start"] = float(np.mean([first[g[0]] for g in c.groups]))
             best = _select(cands, bld.weights)
             level += 1
             sym, a, b, center, radius, members = _apply(
@@ -624,7 +642,8 @@ def _select(cands: list[_Candidate], w: Weights) -> _Candidate:
     for c in cands:
         c.n = c.covered / cov
         c.score = w.wn * c.n + w.wh * min(c.h, 1.0) + w.wphi * c.phi + w.wl * (c.l / lmax)
-    return max(cands, key=lambda c: (round(c.score, 9), c.covered))
+    # Ties (e.g. a sequence read forwards or backwards) go to the order the art was drawn in.
+    return max(cands, key=lambda c: (round(c.score, 9), c.covered, -c.extra.get("start", 0.0)))
 
 
 # ---------------------------------------------------------------------------------------------
