@@ -11,7 +11,7 @@ from dataclasses import replace
 
 from .grammar.model import Case, Grammar, Module, Pop, Push, Rule, Symbol
 
-__all__ = ["simplify"]
+__all__ = ["drop_unreachable", "simplify"]
 
 
 def _uses(g: Grammar) -> dict[str, int]:
@@ -93,9 +93,13 @@ def simplify(g: Grammar) -> Grammar:
             rules = new_rules
             changed = True
             break
-    reachable = _reachable(rules, g.axiom)
-    rules = [r for r in rules if r.name in reachable]
-    return replace(g, rules=tuple(rules))
+    return drop_unreachable(replace(g, rules=tuple(rules)))
+
+
+def drop_unreachable(g: Grammar) -> Grammar:
+    """Return ``g`` without the rules that the axiom can never reach."""
+    reachable = _reachable(list(g.rules), g.axiom)
+    return replace(g, rules=tuple(r for r in g.rules if r.name in reachable))
 
 
 def _reachable(rules: list[Rule], axiom: tuple[Module, ...]) -> set[str]:
