@@ -137,6 +137,9 @@ def _screenshot(app, window, out: str, timeout: float) -> int:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the editor; return the process exit status."""
+    import multiprocessing
+
+    multiprocessing.freeze_support()  # the inference worker process of a frozen build
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
     from PySide6.QtCore import QCoreApplication, QSettings

@@ -33,6 +33,8 @@ __all__ = ["Canvas", "Frame", "RenderRequest", "View", "recolor"]
 
 SETTLE_MS = 120  # quiet time after pan/zoom before rendering at full quality
 BACKGROUND = (255, 255, 255, 255)
+#: Pixel format of ``Renderer.draw``'s array: RGBA bytes, premultiplied alpha (as skia draws).
+RENDER_FORMAT = QImage.Format.Format_RGBA8888_Premultiplied
 MIN_ZOOM, MAX_ZOOM = 1e-4, 1e4
 #: Colours cycled for the colour-by-group / colour-by-rule modes.
 PALETTE = (
@@ -81,6 +83,7 @@ class RenderRequest:
     """One frame to render: immutable inputs, plus the surface to draw into (set when it starts)."""
 
     drawing: Any
+    color_mode: str
     view: View
     width: int
     height: int
@@ -102,6 +105,7 @@ class Frame:
     renderer: Any
     slot: int
     drawing: Any
+    color_mode: str
     view: View
     size: tuple[int, int]
     dpr: float
@@ -116,12 +120,13 @@ def render_frame(req: RenderRequest, cancel, progress) -> Frame:
     s = req.dpr
     z = req.view.zoom
     region = (-req.view.ox / z, -req.view.oy / z, req.width / (z * s), req.height / (z * s))
+    shown = recolor(req.drawing, req.color_mode)  # a copy with other styles: off the UI thread
     pixels = req.renderer.draw(
-        req.drawing, region, not req.draft, req.draft, background=BACKGROUND, highlight=req.highlight
+        shown, region, not req.draft, req.draft, background=BACKGROUND, highlight=req.highlight
     )
     cancel.check()
     h, w = pixels.shape[:2]
-    image = QImage(pixels.data, w, h, pixels.strides[0], core.RENDER_FORMAT)
+    image = QImage(pixels.data, w, h, pixels.strides[0], RENDER_FORMAT)
     image.setDevicePixelRatio(s)
     if req.overlay is not None and req.overlay_rect is not None:
         painter = QPainter(image)
@@ -136,6 +141,7 @@ def render_frame(req: RenderRequest, cancel, progress) -> Frame:
         req.renderer,
         req.slot,
         req.drawing,
+        req.color_mode,
         req.view,
         (req.width, req.height),
         s,
@@ -192,15 +198,11 @@ class Canvas(QWidget):
     -------
     elementClicked(index)
         Instance index under a click (-1: none).
-    idleChanged()
-        :meth:`is_idle` may have changed (whether the frame on screen is final: full quality,
-        current drawing and view).
     message(text)
         A rendering error for the user.
     """
 
     elementClicked = Signal(int)
-    idleChanged = Signal()
     message = Signal(str)
 
     def __init__(self, parent: QWidget | None = None) -> None:
@@ -214,8 +216,8 @@ class Canvas(QWidget):
         self.color_mode = "none"
         self.overlay_visible = False
         self._overlay: Any = None
+        self._overlay_path: str | None = None
         self._overlay_rect: QRectF | None = None
-        self._shown: Any = None  # the drawing as rendered (recoloured)
         self._frame: Frame | None = None
         self._renderers: dict[int, Any] = {}
         self._fit_pending = True
@@ -227,7 +229,6 @@ class Canvas(QWidget):
         self._space = False
         self._interacting = False
         self._interactive_source: Callable[[], bool] = lambda: False
-        self._idle = True
         self.last_frame_seconds = 0.0
         self._highlight: np.ndarray | None = None
         self._highlight_rule: int | None = None
@@ -253,7 +254,6 @@ class Canvas(QWidget):
     def set_drawing(self, drawing: Any) -> None:
         """Show a new drawing (fits the view the first time after a file was opened)."""
         self.drawing = drawing
-        self._shown = recolor(drawing, self.color_mode)
         self._centers = None
         self._update_highlight()
         if self._fit_pending and drawing is not None and len(drawing):
@@ -278,26 +278,32 @@ class Canvas(QWidget):
     def set_color_mode(self, mode: str) -> None:
         """Colour elements by ``"group"``, ``"rule"`` or not at all (``"none"``)."""
         self.color_mode = mode
-        self._shown = recolor(self.drawing, mode)
         self.request_render()
 
     def set_overlay_svg(self, path: str | None) -> None:
         """Use the SVG file ``path`` as the comparison overlay (None: no overlay)."""
+        self._overlay_path = path
         self._overlay, self._overlay_rect = None, None
-        if path:
-            from PySide6.QtSvg import QSvgRenderer
-
-            renderer = QSvgRenderer(path)
-            if renderer.isValid():
-                self._overlay = renderer
-                self._overlay_rect = QRectF(renderer.viewBoxF())
         if self.overlay_visible:
+            self._load_overlay()
             self.request_render()
 
     def set_overlay_visible(self, visible: bool) -> None:
-        """Show or hide the translucent input overlay."""
+        """Show or hide the translucent input overlay (the SVG is read the first time)."""
         self.overlay_visible = bool(visible)
+        if self.overlay_visible and self._overlay is None:
+            self._load_overlay()
         self.request_render()
+
+    def _load_overlay(self) -> None:
+        from PySide6.QtSvg import QSvgRenderer
+
+        if self._overlay_path:
+            renderer = QSvgRenderer(self._overlay_path)
+            renderer.setAnimationEnabled(False)  # a static picture: no timer touching it while a worker draws
+            if renderer.isValid():
+                self._overlay = renderer
+                self._overlay_rect = QRectF(renderer.viewBoxF())
 
     def fit(self, render: bool = True) -> None:
         """Fit the drawing (or its canvas viewbox) into the widget."""
@@ -339,7 +345,22 @@ class Canvas(QWidget):
 
     def is_idle(self) -> bool:
         """Whether the frame on screen is the final one for the current drawing and view."""
-        return self._compute_idle()
+        if self.runner.busy:
+            return False
+        if self.drawing is None:
+            return True
+        f = self._frame
+        dpr = float(self.devicePixelRatioF())
+        size = (max(1, round(self.width() * dpr)), max(1, round(self.height() * dpr)))
+        return (
+            f is not None
+            and not f.draft
+            and f.drawing is self.drawing
+            and f.color_mode == self.color_mode
+            and f.view == self.view
+            and f.size == size
+            and f.overlay == (self.overlay_visible and self._overlay is not None)
+        )
 
     def shutdown(self) -> None:
         """Stop the render worker."""
@@ -368,18 +389,25 @@ class Canvas(QWidget):
         """Ask for a frame of the current drawing and view (a draft while interacting)."""
         if draft is None:
             draft = self._draft_now()
-        self._set_idle(False)
-        if self._shown is None or self.width() <= 0 or self.height() <= 0:
+        if self.drawing is None or self.width() <= 0 or self.height() <= 0:
             self.runner.cancel()
             self.update()
-            self._set_idle(self._compute_idle())
             return
         dpr = float(self.devicePixelRatioF())
         w, h = max(1, round(self.width() * dpr)), max(1, round(self.height() * dpr))
         overlay = self._overlay if self.overlay_visible else None
         self.runner.submit(
             RenderRequest(
-                self._shown, self.view, w, h, dpr, draft, self._highlight, overlay, self._overlay_rect
+                self.drawing,
+                self.color_mode,
+                self.view,
+                w,
+                h,
+                dpr,
+                draft,
+                self._highlight,
+                overlay,
+                self._overlay_rect,
             )
         )
         self.update()
@@ -415,38 +443,11 @@ class Canvas(QWidget):
         self._frame = frame
         self.last_frame_seconds = frame.seconds
         self.update()
-        self._set_idle(self._compute_idle())
-        if not frame.draft or self._interacting or self._interactive_source():
-            return
-        if frame.drawing is self._shown and frame.view == self.view:
-            return
-        self.request_render(draft=False)
+        if frame.draft and not self._interacting and not self._interactive_source():
+            self.request_render(draft=False)  # the interaction is over: the final frame is full quality
 
     def _on_render_failed(self, message: str) -> None:
         self.message.emit(f"Rendering failed: {message}")
-        self._set_idle(self._compute_idle())
-
-    def _compute_idle(self) -> bool:
-        if self.runner.busy:
-            return False
-        if self._shown is None:
-            return True
-        f = self._frame
-        dpr = float(self.devicePixelRatioF())
-        size = (max(1, round(self.width() * dpr)), max(1, round(self.height() * dpr)))
-        return (
-            f is not None
-            and not f.draft
-            and f.drawing is self._shown
-            and f.view == self.view
-            and f.size == size
-            and f.overlay == (self.overlay_visible and self._overlay is not None)
-        )
-
-    def _set_idle(self, idle: bool) -> None:
-        if idle != self._idle:
-            self._idle = idle
-            self.idleChanged.emit()
 
     # -- Qt events ------------------------------------------------------------------------------------
     def paintEvent(self, event) -> None:
@@ -472,6 +473,12 @@ class Canvas(QWidget):
         if not self._user_moved and self.drawing is not None:
             self.fit(render=False)
         self._interact()
+
+    def event(self, event) -> bool:
+        """Render again when the screen's device pixel ratio changes (HiDPI)."""
+        if event.type() == event.Type.DevicePixelRatioChange:
+            self.request_render()
+        return super().event(event)
 
     def wheelEvent(self, event) -> None:
         """Zoom at the cursor."""

@@ -1,8 +1,10 @@
 """The editor's door to ``lsys_core``: every computation the widgets ask for goes through here.
 
-The functions only forward to the library (imported on first use, so the window appears
-before scikit-learn and friends are loaded) and convert plain values (settings dicts,
-file reads) at the boundary.  Nothing here computes geometry or grammars.
+The functions forward to the library (imported on first use, so the window appears before
+scipy and svgelements are loaded) and convert plain values (settings dicts, file reads) at
+the boundary.  The only arithmetic here is display bookkeeping: a bounding disc per terminal
+(from ``lsys_core.svg.export.terminal_points``) to pick the element under a click.  Nothing
+imports Qt (the inference worker process uses this module too).
 """
 
 from __future__ import annotations
@@ -11,14 +13,10 @@ import dataclasses
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtGui import QImage
-
 from lsys_core.derive import Randomize
-from lsys_core.errors import Cancelled, LsysError
+from lsys_core.errors import LsysError
 
 __all__ = [
-    "RENDER_FORMAT",
-    "Cancelled",
     "axiom_count",
     "default_settings",
     "drawing_bounds",
@@ -34,12 +32,11 @@ __all__ = [
     "parse_grammar",
     "randomize_from_dict",
     "read_text",
-    "relaxed_settings",
     "replace_terminal",
     "replace_with_terminal",
-    "set_axiom_count",
     "set_param",
     "settings_from_dict",
+    "shape_from_svg",
     "symmetrize",
     "write_atomic",
 ]
@@ -78,11 +75,6 @@ def default_settings() -> Any:
         return _settings_type()()
     except ImportError:
         return None
-
-
-def relaxed_settings(settings: Any) -> Any:
-    """Return the relaxed variant of ``settings`` used by symmetrize."""
-    return settings.relaxed()
 
 
 def settings_from_dict(values: dict[str, Any]) -> Any:
@@ -142,11 +134,29 @@ def replace_with_terminal(grammar: Any, nonterminal: str, terminal: str) -> Any:
     return _replace(grammar, nonterminal, terminal)
 
 
-def set_axiom_count(grammar: Any, m: int) -> Any:
-    """Return ``grammar`` with the axiom's counter set to ``m``."""
-    from lsys_core.edit import set_axiom_count as _set
+def shape_from_svg(path: str) -> tuple[str, str]:
+    """Return the path data (all shapes of the file joined) and style (the first shape's) of an SVG.
 
-    return _set(grammar, m)
+    Used to replace a terminal by a shape drawn elsewhere; ``replace_terminal`` places it.
+
+    Raises
+    ------
+    LsysError
+        If the file cannot be read or holds no shape.
+    """
+    import numpy as np
+
+    from lsys_core.errors import SvgError
+    from lsys_core.svg.pathdata import d_from_cubics
+
+    scene = load_svg(path)
+    if not scene.elements:
+        raise SvgError(f"{path} holds no shape")
+    cubics = np.concatenate([e.cubics for e in scene.elements])
+    offsets = np.cumsum([0] + [len(e.closed) for e in scene.elements[:-1]])
+    subpaths = np.concatenate([e.subpaths + o for e, o in zip(scene.elements, offsets, strict=True)])
+    closed = tuple(c for e in scene.elements for c in e.closed)
+    return d_from_cubics(cubics, subpaths, closed), scene.elements[0].style
 
 
 def export_svg(drawing: Any, path: str) -> None:
@@ -161,10 +171,6 @@ def export_png(drawing: Any, path: str, **options: Any) -> None:
     from lsys_core.render import render_png
 
     render_png(drawing, path, **options)
-
-
-#: Pixel format of ``Renderer.draw``'s RGBA array (premultiplied alpha, as skia stores it).
-RENDER_FORMAT = QImage.Format.Format_RGBA8888_Premultiplied
 
 
 def make_renderer(width: int, height: int) -> Any:
@@ -237,7 +243,7 @@ def drawing_bounds(drawing: Any) -> tuple[float, float, float, float] | None:
 
 
 def axiom_count(grammar: Any) -> int | None:
-    """Return the axiom's counter m (the alias ``m`` of ``set_param``), or None if it has none."""
+    """Return the axiom's counter m (``set_param(g, "m", value)`` changes it), or None if it has none."""
     for p in list_params(grammar):
         if p.kind == "count" and p.key.startswith("axiom."):
             return int(p.value)

@@ -15,81 +15,26 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import os
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import QObject, QTimer, Signal
 from PySide6.QtGui import QUndoStack
 
-from lsys_core.cancel import CancelToken, Progress
-from lsys_core.derive import Randomize, derive
-from lsys_core.errors import Cancelled, GrammarError, LsysError
+from lsys_core.derive import Randomize
+from lsys_core.errors import GrammarError, LsysError
 
 from . import core
 from .commands import RandomizeCommand, SettingsCommand, TextCommand
-from .workers import LatestRunner
+from .jobs import DeriveRequest, InferOutcome, InferRequest, run_derive, run_inference
+from .workers import LatestRunner, ProcessCompute
 
-__all__ = ["DeriveRequest", "Document", "InferOutcome", "InferRequest"]
+__all__ = ["Document"]
 
 PARSE_DELAY_MS = 150
 INFER_DELAY_MS = 250
-DERIVE_LIMIT = 1_000_000
-
-
-@dataclass(frozen=True)
-class InferRequest:
-    """What an inference job needs, snapshot on the UI thread.
-
-    ``scene`` is None when ``svg_path`` is to be loaded first (opening a file).
-    """
-
-    scene: Any
-    settings: Any
-    randomize: Randomize | None = None
-    symmetrize: bool = False
-    svg_path: str | None = None
-    limit: int = DERIVE_LIMIT
-
-
-@dataclass(frozen=True)
-class InferOutcome:
-    """Result of an inference job: the scene, the inference result, its text and drawing."""
-
-    scene: Any
-    result: Any
-    text: str
-    drawing: Any
-    derive_error: str | None = None
-
-
-@dataclass(frozen=True)
-class DeriveRequest:
-    """What a derivation job needs: the grammar and how to perturb it."""
-
-    grammar: Any
-    randomize: Randomize | None = None
-    limit: int = DERIVE_LIMIT
-
-
-def run_inference(request: InferRequest, cancel: CancelToken, progress: Progress) -> InferOutcome:
-    """Load (if asked), infer or symmetrize, format and derive; runs on a worker."""
-    scene = request.scene if request.scene is not None else core.load_svg(request.svg_path)
-    run = core.symmetrize if request.symmetrize else core.infer
-    result = run(scene, request.settings, cancel=cancel, progress=progress)
-    text = core.format_grammar(result.grammar)
-    try:
-        drawing = derive(result.grammar, limit=request.limit, randomize=request.randomize, cancel=cancel)
-    except Cancelled:
-        raise
-    except LsysError as exc:
-        return InferOutcome(scene, result, text, None, str(exc))
-    return InferOutcome(scene, result, text, drawing)
-
-
-def run_derive(request: DeriveRequest, cancel: CancelToken, progress: Progress) -> Any:
-    """Derive the grammar into a drawing; runs on a worker."""
-    return derive(request.grammar, limit=request.limit, randomize=request.randomize, cancel=cancel)
+#: Modules the inference process imports as it starts (while the window opens).
+INFER_PRELOAD = ("lsys_core.pipeline", "lsys_core.similarity", "lsys_core.svg.parse", "lsys_core.grammar")
 
 
 class Document(QObject):
@@ -114,7 +59,7 @@ class Document(QObject):
         Inference runs in the background; ``inferenceFinished`` also follows failures.
     message(text)
         A readable error or note for the user.
-    pathChanged(), busyChanged() (see :attr:`busy`), gestureFinished()
+    pathChanged(), gestureFinished()
     """
 
     sceneChanged = Signal()
@@ -129,10 +74,15 @@ class Document(QObject):
     inferenceFinished = Signal()
     message = Signal(str)
     pathChanged = Signal()
-    busyChanged = Signal()
     gestureFinished = Signal()
 
-    def __init__(self, parent: QObject | None = None, *, infer_compute=None) -> None:
+    def __init__(self, parent: QObject | None = None, *, infer_compute: Any = None) -> None:
+        """Create an empty document.
+
+        ``infer_compute`` runs inference jobs (default: a worker process of its own, see
+        :data:`INFER_PRELOAD`); pass a shared :class:`~app.workers.ProcessCompute` or
+        :func:`~app.jobs.run_inference` itself (a worker thread) to override.
+        """
         super().__init__(parent)
         self.undo_stack = QUndoStack(self)
         self.scene: Any = None
@@ -154,18 +104,20 @@ class Document(QObject):
         self._parse_timer.setInterval(PARSE_DELAY_MS)
         self._parse_timer.timeout.connect(self._parse_now)
 
+        self._own_process = infer_compute is None
+        if infer_compute is None:
+            infer_compute = ProcessCompute(run_inference, preload=INFER_PRELOAD)
+        self._infer_compute = infer_compute
         self.inference = LatestRunner(
-            infer_compute or run_inference, debounce_ms=INFER_DELAY_MS, name="lsys-inference", parent=self
+            infer_compute, debounce_ms=INFER_DELAY_MS, name="lsys-inference", parent=self
         )
         self.inference.started.connect(self.inferenceStarted)
         self.inference.progress.connect(self.inferenceProgress)
         self.inference.resultReady.connect(self._on_inferred)
         self.inference.failed.connect(self._on_infer_failed)
-        self.inference.busyChanged.connect(self._emit_busy)
         self.deriver = LatestRunner(run_derive, name="lsys-derive", parent=self)
         self.deriver.resultReady.connect(self._on_derived)
         self.deriver.failed.connect(self._on_derive_failed)
-        self.deriver.busyChanged.connect(self._emit_busy)
 
     # -- queries --------------------------------------------------------------------------------
     @property
@@ -184,9 +136,14 @@ class Document(QObject):
         return self._gesture is not None
 
     @property
+    def loading(self) -> bool:
+        """Whether a file is being opened (or the input reloaded) in the background."""
+        return self._infer_purpose[0] in ("open", "reload")
+
+    @property
     def can_infer(self) -> bool:
-        """Whether an input scene is loaded, so inference and symmetrize can run."""
-        return self.scene is not None
+        """Whether an input scene is loaded and no file is loading, so inference can run."""
+        return self.scene is not None and not self.loading
 
     def stats(self) -> dict[str, Any]:
         """Return figures for the status bar (elements, symbols, rules, compression, time)."""
@@ -213,9 +170,7 @@ class Document(QObject):
     def open_svg(self, path: str) -> None:
         """Load an SVG and infer its grammar in the background (replaces the document when done)."""
         self._infer_purpose = ("open", str(path))
-        self.inference.submit(
-            InferRequest(None, self.settings, self.randomize, svg_path=str(path)), immediate=True
-        )
+        self.inference.submit(InferRequest(None, self.settings, svg_path=str(path)), immediate=True)
 
     def open_lsys(self, path: str) -> None:
         """Open an .lsys rules file; the input scene is cleared.
@@ -226,7 +181,8 @@ class Document(QObject):
             If the file cannot be read (a parse error only marks the text).
         """
         text = core.read_text(path)
-        self.inference.cancel()
+        self.cancel_inference()
+        self._set_randomize_silently(None)
         self.scene = None
         self.scene_path = None
         self.result = None
@@ -251,24 +207,21 @@ class Document(QObject):
 
     def restore(self, state: dict[str, Any]) -> None:
         """Restore a recovered session (rules text, settings, randomization, file names)."""
-        self.inference.cancel()
+        self.cancel_inference()
         self.undo_stack.clear()
         self.settings = core.settings_from_dict(state.get("settings") or {})
         self.settingsChanged.emit(self.settings)
-        self.randomize = core.randomize_from_dict(state.get("randomize"))
-        self.randomizeChanged.emit(self.randomize)
+        self._set_randomize_silently(core.randomize_from_dict(state.get("randomize")))
         self.path = state.get("path")
         scene_path = state.get("scene_path")
         self.scene, self.scene_path, self.result = None, None, None
-        if scene_path and Path(scene_path).is_file():
-            try:
-                self.scene = core.load_svg(scene_path)
-                self.scene_path = scene_path
-            except LsysError as exc:
-                self.message.emit(f"Could not reload {scene_path}: {exc}")
         self.sceneChanged.emit()
         self.undo_stack.push(TextCommand(self, "Restore unsaved work", self.text, state.get("text", "")))
         self.pathChanged.emit()
+        if scene_path and Path(scene_path).is_file():  # load the input in the background, no inference
+            self._infer_purpose = ("reload", scene_path)
+            request = InferRequest(None, self.settings, svg_path=scene_path, load_only=True)
+            self.inference.submit(request, immediate=True)
 
     def snapshot(self) -> dict[str, Any]:
         """Return the state autosave writes (see :meth:`restore`)."""
@@ -291,21 +244,36 @@ class Document(QObject):
             self._gesture = None
             self.gestureFinished.emit()
 
+    def editable_grammar(self) -> Any:
+        """Return the grammar of the current text for an edit, or None if the text does not parse.
+
+        Text typed in the last moments is parsed first, so an edit never starts from a stale
+        grammar (and never discards what was just typed).
+        """
+        if self._parse_timer.isActive():
+            self._parse_timer.stop()
+            self._parse_now()
+        if self.error is not None:
+            self.message.emit(f"Fix the rules first: {self.error}")
+            return None
+        return self.grammar
+
     def _merge_key(self, what: str) -> Any:
         return (what, self._gesture) if self._gesture is not None else None
 
     def edit_text(self, text: str) -> None:
         """Record typing in the rules editor (merged with the typing just before)."""
         if text != self.text:
-            self.inference.cancel()
+            self._supersede_inference()
             self.undo_stack.push(TextCommand(self, "Edit rules", self.text, text, merge_key="typing"))
 
     def set_param(self, key: str, value: float) -> None:
         """Change one numeric parameter of the rules; re-derives without re-inference."""
-        if self.grammar is None or self.error is not None:
+        current = self.editable_grammar()
+        if current is None:
             return
         try:
-            grammar = core.set_param(self.grammar, key, value)
+            grammar = core.set_param(current, key, value)
         except LsysError as exc:
             self.message.emit(str(exc))
             return
@@ -313,7 +281,7 @@ class Document(QObject):
 
     def apply_grammar(self, grammar: Any, label: str, *, merge_key: Any = None, drawing: Any = None) -> None:
         """Replace the grammar by an edited one (undoable; the text is regenerated)."""
-        self.inference.cancel()
+        self._supersede_inference()
         text = core.format_grammar(grammar)
         self.undo_stack.push(
             TextCommand(self, label, self.text, text, merge_key=merge_key, grammar=grammar, drawing=drawing)
@@ -321,7 +289,7 @@ class Document(QObject):
 
     def set_settings(self, settings: Any) -> None:
         """Change the inference settings; re-runs inference in the background (undoable)."""
-        if settings == self.settings:
+        if settings == self.settings or self.loading:
             return
         self.undo_stack.push(
             SettingsCommand(self, self.settings, settings, self.text, merge_key=self._merge_key("settings"))
@@ -336,7 +304,7 @@ class Document(QObject):
 
     def symmetrize(self) -> None:
         """Re-infer with relaxed tolerance in the background; applied as one undoable step."""
-        if self.scene is None:
+        if not self.can_infer:
             self.message.emit("Symmetrize needs an input SVG: open one first.")
             return
         self._infer_purpose = ("symmetrize", None)
@@ -346,7 +314,7 @@ class Document(QObject):
 
     def reinfer(self) -> None:
         """Run inference again with the current settings."""
-        if self.scene is not None:
+        if self.can_infer:
             self._infer_purpose = ("reinfer", None)
             self.inference.submit(InferRequest(self.scene, self.settings, self.randomize), immediate=True)
 
@@ -356,11 +324,19 @@ class Document(QObject):
         self._infer_purpose = ("none", None)
         self.inferenceFinished.emit()
 
+    def warm_up(self) -> None:
+        """Start the inference process early, so the first inference does not wait for imports."""
+        start = getattr(self._infer_compute, "start", None)
+        if start is not None:
+            start()
+
     def shutdown(self) -> None:
         """Cancel all background work and wait for the worker threads to end."""
         self._parse_timer.stop()
         self.inference.shutdown()
         self.deriver.shutdown()
+        if self._own_process:
+            self._infer_compute.close()
 
     # -- appliers (called by commands and results) ---------------------------------------------------
     def _apply_text(
@@ -368,12 +344,14 @@ class Document(QObject):
     ) -> None:
         changed = text != self.text
         self.text = text
+        if grammar is not None:  # derive first: the worker runs while the panels update
+            self._parse_timer.stop()
+            self._set_grammar(grammar, drawing)
         if changed:
             self.textChanged.emit(text)
         if grammar is not None:
-            self._parse_timer.stop()
-            self._set_grammar(grammar, drawing)
-        elif typing:
+            return
+        if typing:
             self._parse_timer.start()
         else:
             self._parse_timer.stop()
@@ -391,16 +369,17 @@ class Document(QObject):
     def _set_grammar(self, grammar: Any, drawing: Any) -> None:
         had_error = self.error is not None
         self.error = None
-        if had_error:
-            self.grammarError.emit(None)
-        if grammar != self.grammar:
-            self.grammar = grammar
-            self.grammarChanged.emit(grammar)
+        changed = grammar != self.grammar
+        self.grammar = grammar
         if drawing is not None:
             self.deriver.cancel()
             self._set_drawing(drawing)
         else:
-            self.request_derive()
+            self.request_derive()  # before the panels update, so the worker starts at once
+        if had_error:
+            self.grammarError.emit(None)
+        if changed:
+            self.grammarChanged.emit(grammar)
 
     def request_derive(self) -> None:
         """Derive the current grammar again in the background."""
@@ -415,15 +394,31 @@ class Document(QObject):
         self.settings = settings
         self.settingsChanged.emit(settings)
         if text is not None:
-            self.inference.cancel()
+            self._supersede_inference()
             self._apply_text(text)
         elif self.scene is not None:
             self._infer_purpose = ("settings", command)
             self.inference.submit(InferRequest(self.scene, settings, self.randomize))
 
+    def _supersede_inference(self) -> None:
+        """Cancel an inference whose result would replace the rules the user is now editing.
+
+        Opening a file or reloading the input scene is not cancelled: it is not about the rules.
+        """
+        if self._infer_purpose[0] in ("settings", "reinfer", "symmetrize"):
+            self.inference.cancel()
+            self._infer_purpose = ("none", None)
+            self.inferenceFinished.emit()
+
     def _retarget_inference(self, old: SettingsCommand, new: SettingsCommand) -> None:
         if self._infer_purpose == ("settings", old):
             self._infer_purpose = ("settings", new)
+
+    def _set_randomize_silently(self, randomize: Randomize | None) -> None:
+        """Set the randomization of a new document (not an edit: nothing is derived here)."""
+        if randomize != self.randomize:
+            self.randomize = randomize
+            self.randomizeChanged.emit(randomize)
 
     def _apply_randomize(self, randomize: Randomize | None) -> None:
         self.randomize = randomize
@@ -431,17 +426,20 @@ class Document(QObject):
         self.request_derive()
 
     # -- worker results --------------------------------------------------------------------------------
-    def _emit_busy(self) -> None:
-        self.busyChanged.emit()
-
     def _on_inferred(self, out: InferOutcome) -> None:
         purpose, data = self._infer_purpose
         self._infer_purpose = ("none", None)
+        if purpose == "reload":
+            self.scene, self.scene_path = out.scene, data
+            self.sceneChanged.emit()
+            self.inferenceFinished.emit()
+            return
         self.result = out.result
         if out.derive_error:
             self.message.emit(out.derive_error)
         if purpose == "open":
             self.scene, self.scene_path, self.path = out.scene, data, None
+            self._set_randomize_silently(None)
             self.undo_stack.clear()
             self.grammar = None
             self.sceneChanged.emit()
@@ -465,7 +463,8 @@ class Document(QObject):
     def _on_infer_failed(self, message: str) -> None:
         purpose, data = self._infer_purpose
         self._infer_purpose = ("none", None)
-        what = f"Could not open {os.path.basename(data)}" if purpose == "open" else "Inference failed"
+        what = {"open": "Could not open", "reload": "Could not reload"}.get(purpose)
+        what = f"{what} {os.path.basename(data)}" if what else "Inference failed"
         self.message.emit(f"{what}: {message}")
         self.inferenceFinished.emit()
 

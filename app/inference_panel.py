@@ -103,7 +103,7 @@ class InferencePanel(QWidget):
         super().__init__(parent)
         self._settings: Any = None
         self.rows: dict[str, _SettingRow] = {}
-        weights = QGroupBox("Cluster importance and similarity", self)
+        weights = self.weights_box = QGroupBox("Cluster importance and similarity", self)
         form = QFormLayout(weights)
         for name, label, low, high, tip in FIELDS:
             row = _SettingRow(name, low, high, weights)
@@ -141,6 +141,11 @@ class InferencePanel(QWidget):
             row.setEnabled(name in names)
             if name in names:
                 row.set_value(float(getattr(settings, name)))
+
+    def set_editable(self, editable: bool) -> None:
+        """Enable the settings and Re-infer (there is an input to infer from); Cancel stays usable."""
+        self.weights_box.setEnabled(editable)
+        self.reinfer_button.setEnabled(editable)
 
     def set_running(self, running: bool) -> None:
         """Enable Cancel while inference runs; reset the stage bars when a run starts."""

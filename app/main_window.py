@@ -11,16 +11,14 @@ import os
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import QSettings, Qt, QTimer, Signal
+from PySide6.QtCore import QSettings, Qt, QTimer
 from PySide6.QtGui import QAction, QActionGroup, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QDockWidget,
     QFileDialog,
-    QHBoxLayout,
     QLabel,
     QMainWindow,
     QMessageBox,
-    QToolButton,
     QVBoxLayout,
     QWidget,
 )
@@ -32,44 +30,15 @@ from .canvas import Canvas
 from .dialogs import RandomizeDialog, ReplaceDialog
 from .document import Document
 from .inference_panel import InferencePanel
+from .message_bar import MessageBar
 from .params_panel import ParamsPanel
+from .recent_files import RecentFiles
 from .recovery import Recovery
 from .rules_panel import RulesPanel
 
-__all__ = ["MainWindow", "MessageBar"]
+__all__ = ["MainWindow"]
 
-MAX_RECENT = 10
 FILE_FILTER = "SVG or L-system (*.svg *.lsys);;SVG files (*.svg);;L-system rules (*.lsys);;All files (*)"
-
-
-class MessageBar(QWidget):
-    """A dismissable line above the canvas showing the latest error or note."""
-
-    def __init__(self, parent: QWidget | None = None) -> None:
-        super().__init__(parent)
-        self.label = QLabel(self)
-        self.label.setWordWrap(True)
-        self.label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
-        close = QToolButton(self)
-        close.setText("✕")
-        close.setAutoRaise(True)
-        close.clicked.connect(self.hide)
-        layout = QHBoxLayout(self)
-        layout.setContentsMargins(8, 4, 4, 4)
-        layout.addWidget(self.label, 1)
-        layout.addWidget(close)
-        self.setAutoFillBackground(True)
-        self.setStyleSheet("MessageBar { background: #fdecea; } QLabel { color: #611a15; }")
-        self.hide()
-
-    def show_message(self, text: str) -> None:
-        """Show ``text`` (replacing the previous message)."""
-        self.label.setText(text)
-        self.show()
-
-    def text(self) -> str:
-        """Return the message shown (empty when hidden)."""
-        return self.label.text() if self.isVisible() else ""
 
 
 class MainWindow(QMainWindow):
@@ -80,24 +49,27 @@ class MainWindow(QMainWindow):
     settings : QSettings, optional
         Where layout and recent files are kept (default: the application's settings).
     restore_layout : bool
-        Restore the saved window geometry and dock layout.
+        Restore the saved window geometry and dock layout, and save them on close.
     autosave : bool
         Autosave the document for crash recovery.
-
-    Signals
-    -------
-    idle()
-        Emitted when no computation is pending and the canvas shows the final rendering.
+    infer_compute : callable, optional
+        How inference jobs run (see :class:`~app.document.Document`; default: own process).
     """
 
-    idle = Signal()
-
     def __init__(
-        self, settings: QSettings | None = None, *, restore_layout: bool = True, autosave: bool = True
+        self,
+        settings: QSettings | None = None,
+        *,
+        restore_layout: bool = True,
+        autosave: bool = True,
+        infer_compute: Any = None,
     ):
         super().__init__()
         self.settings = settings or QSettings()
-        self.doc = Document(self)
+        self.recent = RecentFiles(self.settings, self)
+        self.recent.openRequested.connect(self.open_path)
+        self.doc = Document(self, infer_compute=infer_compute)
+        QTimer.singleShot(0, self.doc.warm_up)
         self.setAcceptDrops(True)
         self.resize(1400, 900)
 
@@ -140,12 +112,8 @@ class MainWindow(QMainWindow):
         self._update_status()
         self._update_title()
 
-        self._idle_timer = QTimer(self)
-        self._idle_timer.setSingleShot(True)
-        self._idle_timer.setInterval(30)
-        self._idle_timer.timeout.connect(self._check_idle)
-
         self.recovery = Recovery(self.doc, parent=self) if autosave else None
+        self._keep_layout = restore_layout
         if restore_layout:
             geometry = self.settings.value("window/geometry")
             state = self.settings.value("window/state")
@@ -220,7 +188,7 @@ class MainWindow(QMainWindow):
         file_menu = bar.addMenu("&File")
         file_menu.addAction(self.act_open)
         self.recent_menu = file_menu.addMenu("Open &Recent")
-        self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
+        self.recent.attach(self.recent_menu)
         file_menu.addSeparator()
         for act in (self.act_save, self.act_save_as):
             file_menu.addAction(act)
@@ -279,15 +247,14 @@ class MainWindow(QMainWindow):
         d.settingsChanged.connect(self.inference_panel.set_settings)
         d.sceneChanged.connect(self._on_scene_changed)
         d.inferenceStarted.connect(lambda: self.inference_panel.set_running(True))
+        d.inferenceStarted.connect(self._update_actions)
         d.inferenceProgress.connect(self.inference_panel.set_progress)
         d.inferenceFinished.connect(self._on_inference_finished)
         d.message.connect(self.show_message)
         d.pathChanged.connect(self._update_title)
         d.pathChanged.connect(self._update_actions)
         d.undo_stack.cleanChanged.connect(self._update_title)
-        d.busyChanged.connect(self._schedule_idle_check)
         d.gestureFinished.connect(self.canvas.request_full_quality)
-        self.canvas.idleChanged.connect(self._schedule_idle_check)
         self.canvas.elementClicked.connect(self._on_element_clicked)
         self.canvas.message.connect(self.show_message)
         self.rules_panel.textEdited.connect(d.edit_text)
@@ -326,7 +293,7 @@ class MainWindow(QMainWindow):
         self.canvas.set_highlight_rule(None)
         self.rules_panel.highlight_rule(None)
         if self.doc.scene_path:
-            self.add_recent(self.doc.scene_path)
+            self.recent.add(self.doc.scene_path)
             self.canvas.fit_on_next_drawing()
         self.message_bar.hide()
         self._update_actions()
@@ -336,6 +303,7 @@ class MainWindow(QMainWindow):
         self.inference_panel.set_running(False)
         self.statusBar().clearMessage()
         self._update_status()
+        self._update_actions()
 
     def _on_element_clicked(self, index: int) -> None:
         drawing, grammar = self.doc.drawing, self.doc.grammar
@@ -353,7 +321,7 @@ class MainWindow(QMainWindow):
         d = self.doc
         has_grammar = d.grammar is not None
         self.act_symmetrize.setEnabled(d.can_infer)
-        self.inference_panel.setEnabled(d.can_infer)
+        self.inference_panel.set_editable(d.can_infer)
         for act in (
             self.act_randomize,
             self.act_replace,
@@ -393,13 +361,6 @@ class MainWindow(QMainWindow):
         """Whether nothing is pending: no inference, parse or derivation, and the canvas is final."""
         return not self.doc.busy and self.canvas.is_idle()
 
-    def _schedule_idle_check(self, *_args: Any) -> None:
-        self._idle_timer.start()
-
-    def _check_idle(self) -> None:
-        if self.is_idle():
-            self.idle.emit()
-
     # -- files ----------------------------------------------------------------------------------------
     def open_path(self, path: str) -> None:
         """Open an SVG (inferring its rules) or an .lsys file; errors become messages."""
@@ -415,7 +376,7 @@ class MainWindow(QMainWindow):
             except LsysError as exc:
                 self.show_message(f"Could not open {os.path.basename(path)}: {exc}")
                 return
-            self.add_recent(path)
+            self.recent.add(path)
             self.canvas.fit_on_next_drawing()
             self.message_bar.hide()
         else:
@@ -450,7 +411,7 @@ class MainWindow(QMainWindow):
         except LsysError as exc:
             self.show_message(f"Could not save: {exc}")
             return False
-        self.add_recent(path)
+        self.recent.add(path)
         self.statusBar().showMessage(f"Saved {path}", 5000)
         return True
 
@@ -497,35 +458,8 @@ class MainWindow(QMainWindow):
         return os.path.join(self._last_dir(), "derived" + suffix)
 
     def _last_dir(self) -> str:
-        recent = self.recent_files()
+        recent = self.recent.files()
         return os.path.dirname(recent[0]) if recent else os.getcwd()
-
-    # -- recent files ---------------------------------------------------------------------------------
-    def recent_files(self) -> list[str]:
-        """Return the recent files, newest first."""
-        value = self.settings.value("recentFiles", [])
-        if isinstance(value, str):
-            value = [value]
-        return [str(v) for v in (value or [])]
-
-    def add_recent(self, path: str) -> None:
-        """Put ``path`` first in the recent-files list."""
-        path = os.path.abspath(path)
-        files = [path] + [f for f in self.recent_files() if f != path]
-        self.settings.setValue("recentFiles", files[:MAX_RECENT])
-
-    def _fill_recent_menu(self) -> None:
-        self.recent_menu.clear()
-        files = self.recent_files()
-        for i, path in enumerate(files):
-            act = self.recent_menu.addAction(f"&{i + 1} {os.path.basename(path)}")
-            act.setToolTip(path)
-            act.triggered.connect(lambda _checked=False, p=path: self.open_path(p))
-        if not files:
-            self.recent_menu.addAction("(none)").setEnabled(False)
-        else:
-            self.recent_menu.addSeparator()
-            self.recent_menu.addAction("Clear", lambda: self.settings.setValue("recentFiles", []))
 
     # -- actions ---------------------------------------------------------------------------------------
     def randomize_dialog(self) -> None:
@@ -539,10 +473,11 @@ class MainWindow(QMainWindow):
 
     def replace_dialog(self) -> None:
         """Show the replace-symbol dialog and apply the choice."""
-        if self.doc.grammar is None:
+        grammar = self.doc.editable_grammar()
+        if grammar is None:
             return
         inst = getattr(self.doc.result, "instancing", None)
-        dialog = ReplaceDialog(self.doc.grammar, getattr(inst, "terminals", ()), core.shape_from_svg, self)
+        dialog = ReplaceDialog(grammar, getattr(inst, "terminals", ()), core.shape_from_svg, self)
         if dialog.exec():
             choice = dialog.choice()
             if choice is not None:
@@ -550,7 +485,9 @@ class MainWindow(QMainWindow):
 
     def replace_symbol(self, choice) -> None:
         """Apply a :class:`~app.dialogs.ReplaceChoice` to the grammar (undoable)."""
-        g = self.doc.grammar
+        g = self.doc.editable_grammar()
+        if g is None:
+            return
         try:
             if choice.kind == "nonterminal":
                 new = core.replace_with_terminal(g, choice.target, choice.terminal)
@@ -561,11 +498,14 @@ class MainWindow(QMainWindow):
         except LsysError as exc:
             self.show_message(f"Cannot replace: {exc}")
             return
+        except ImportError:
+            self.show_message("Replacing symbols needs lsys_core.edit, which is not installed.")
+            return
         self.doc.apply_grammar(new, label)
 
     def change_count(self, step: int) -> None:
         """Grow (``step > 0``) or shrink the structure by changing the axiom's counter m."""
-        g = self.doc.grammar
+        g = self.doc.editable_grammar()
         if g is None:
             return
         try:
@@ -574,7 +514,7 @@ class MainWindow(QMainWindow):
                 self.show_message("The axiom has no counter m to change.")
                 return
             new_m = max(0, m + step * max(1, round(abs(m) * 0.1)))
-            self.doc.apply_grammar(core.set_axiom_count(g, new_m), "Grow" if step > 0 else "Shrink")
+            self.doc.apply_grammar(core.set_param(g, "m", new_m), "Grow" if step > 0 else "Shrink")
         except LsysError as exc:
             self.show_message(str(exc))
 
@@ -621,14 +561,14 @@ class MainWindow(QMainWindow):
         if not self.maybe_save():
             event.ignore()
             return
-        self.settings.setValue("window/geometry", self.saveGeometry())
-        self.settings.setValue("window/state", self.saveState())
+        if self._keep_layout:
+            self.settings.setValue("window/geometry", self.saveGeometry())
+            self.settings.setValue("window/state", self.saveState())
         self.shutdown()
         event.accept()
 
     def shutdown(self) -> None:
         """Stop every background computation (idempotent)."""
-        self._idle_timer.stop()
         self.doc.shutdown()
         self.canvas.shutdown()
         if self.recovery is not None:

@@ -103,7 +103,13 @@ class ParamRow(QWidget):
         return float(self.spin.value())
 
     def set_value(self, value: float) -> None:
-        """Show ``value`` without emitting :attr:`valueEdited`."""
+        """Show ``value`` without emitting :attr:`valueEdited`.
+
+        A value outside the slider's range (typed, or set by undo) widens the range, unless the
+        slider is being dragged.
+        """
+        if not self.lo <= value <= self.hi and not self.slider.isSliderDown():
+            self.lo, self.hi = slider_range(self.kind, value)
         self.slider.blockSignals(True)
         self.spin.blockSignals(True)
         try:

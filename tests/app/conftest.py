@@ -55,8 +55,20 @@ def helix_lsys(tmp_path) -> Path:
     return path
 
 
+@pytest.fixture(scope="session")
+def inference_process():
+    """One inference worker process shared by the session's windows (as each window's own would be)."""
+    from app.document import INFER_PRELOAD
+    from app.jobs import run_inference
+    from app.workers import ProcessCompute
+
+    compute = ProcessCompute(run_inference, preload=INFER_PRELOAD)
+    yield compute
+    compute.close()
+
+
 @pytest.fixture
-def make_window(qtbot, tmp_path):
+def make_window(qtbot, tmp_path, inference_process):
     """Return a factory of main windows with their own settings file and no autosave.
 
     At teardown every window is closed and no worker thread may be left running.
@@ -72,9 +84,9 @@ def make_window(qtbot, tmp_path):
         settings = QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat)
         kwargs.setdefault("restore_layout", False)
         kwargs.setdefault("autosave", False)
-        win = MainWindow(settings, **kwargs)
-        qtbot.addWidget(win)
-        win.resize(1000, 700)
+        kwargs.setdefault("infer_compute", inference_process)
+        win = MainWindow(settings, **kwargs)  # closed below (qtbot's own closing would ask to save)
+        win.resize(1400, 900)
         win.show()
         windows.append(win)
         return win
@@ -84,6 +96,7 @@ def make_window(qtbot, tmp_path):
         win.doc.undo_stack.setClean()
         win.close()
         win.shutdown()
+        win.deleteLater()
     left = [
         t for t in threading.enumerate() if t not in before and t.is_alive() and t.name.startswith("lsys-")
     ]

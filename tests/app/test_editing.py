@@ -38,7 +38,7 @@ def test_open_lsys_fills_rules_and_params(window, helix_lsys, wait_idle):
     assert len(window.doc.drawing) == 120
     assert "120 elements" in window._status_labels["elements"].text()
     assert window.canvas._frame is not None and not window.canvas._frame.draft
-    assert not window.inference_panel.isEnabled()  # no input SVG: nothing to infer
+    assert not window.inference_panel.weights_box.isEnabled()  # no input SVG: nothing to infer
 
 
 def test_editing_rule_text_rederives_and_keeps_last_drawing_while_invalid(
@@ -59,7 +59,7 @@ def test_editing_rule_text_rederives_and_keeps_last_drawing_while_invalid(
     assert not window.params_panel.isEnabled()
     wait_idle(window)
     assert doc.drawing is good  # the last valid drawing stays
-    assert window.canvas._frame.drawing is window.canvas._shown
+    assert window.canvas._frame.drawing is window.canvas.drawing
 
     _replace_in_editor(window, "f(24", "f(30)")
     qtbot.waitUntil(lambda: doc.error is None and doc.drawing is not good, timeout=5000)
@@ -214,11 +214,15 @@ def test_replace_terminal_shape(window, helix_lsys, wait_idle):
     from app.dialogs import ReplaceChoice
 
     _open(window, helix_lsys, wait_idle)
+    before = window.doc.grammar.terminal("A")
     window.replace_symbol(ReplaceChoice("terminal", "A", path="M 0 0 L 3 0 L 3 3 Z", style="fill:#f00"))
     wait_idle(window)
     term = window.doc.grammar.terminal("A")
-    assert term.style == "fill:#f00" and "3" in term.path
-    assert len(window.doc.drawing) == 120
+    assert term.style == "fill:#f00" and term.path != before.path
+    assert len(window.doc.drawing) == 120 and window.doc.undo_stack.count() == 1
+    window.doc.undo_stack.undo()
+    wait_idle(window)
+    assert window.doc.grammar.terminal("A") == before
 
 
 def test_click_on_element_highlights_its_rule(window, helix_lsys, qtbot, wait_idle):
@@ -273,7 +277,8 @@ def test_color_modes_and_overlay(window, helix_lsys, wait_idle):
     assert "stroke:#1f77b4" in by_group.terminals[0].style and "fill:none" in by_group.terminals[0].style
     window.act_colors["rule"].trigger()
     wait_idle(window)
-    assert window.canvas._frame.drawing is window.canvas._shown and len(window.canvas._shown.terminals) == 2
+    frame = window.canvas._frame
+    assert frame.drawing is window.doc.drawing and frame.color_mode == "rule"
 
 
 def test_save_and_reopen(window, helix_lsys, tmp_path, wait_idle):
@@ -284,7 +289,7 @@ def test_save_and_reopen(window, helix_lsys, tmp_path, wait_idle):
     assert window._save_to(str(out))
     assert out.read_text(encoding="utf-8") == window.doc.text
     assert not window.doc.modified and window.doc.path == str(out)
-    assert window.recent_files()[0] == str(out)
+    assert window.recent.files()[0] == str(out)
 
 
 def test_close_with_unsaved_changes_asks(window, helix_lsys, monkeypatch, wait_idle):
@@ -310,13 +315,55 @@ def test_drop_opens_file_and_recent_menu_lists_it(window, helix_lsys, qtbot, wai
     window.dropEvent(event)
     wait_idle(window)
     assert window.doc.path == str(helix_lsys) and len(window.doc.drawing) == 120
-    window._fill_recent_menu()
+    window.recent.fill_menu()
     assert any(str(helix_lsys) == a.toolTip() for a in window.recent_menu.actions())
 
 
 def test_layout_is_kept_in_settings(make_window):
-    first = make_window()
+    first = make_window(restore_layout=True)
     first.inference_dock.hide()
     first.close()
     second = make_window(restore_layout=True)
     assert not second.inference_dock.isVisible()
+
+
+def test_param_rows_follow_values_outside_their_range(qtbot):
+    from app.params_panel import ParamsPanel, slider_range
+    from lsys_core.grammar import Param
+
+    panel = ParamsPanel()
+    qtbot.addWidget(panel)
+    panel.set_params([Param("P.0.1.v", "P: f #1", 24.0, "distance")])
+    row = panel.rows["P.0.1.v"]
+    assert (row.lo, row.hi) == slider_range("distance", 24.0) == (0.0, 48.0)
+    panel.set_params([Param("P.0.1.v", "P: f #1", 300.0, "distance")])
+    assert panel.rows["P.0.1.v"] is row and row.hi >= 300 and row.value() == pytest.approx(300)
+    assert row.slider.value() < row.slider.maximum()
+    edits = []
+    panel.paramEdited.connect(lambda k, v: edits.append((k, v)))
+    row.slider.setValue(row.slider.maximum())
+    assert edits == [("P.0.1.v", pytest.approx(row.hi))]
+    assert slider_range("scale", 0.99)[0] > 0  # a scale must stay positive
+
+
+def test_replace_dialog_offers_input_shapes_and_svg_files(qtbot, corpus):
+    from app import core
+    from app.dialogs import ReplaceDialog
+    from lsys_core.grammar import Terminal, parse_grammar
+
+    grammar = parse_grammar(
+        'lsys 1\nterminal A "M 0 0 L 4 0 L 4 4 Z"\naxiom: P(3)\nP(m): m > 0 -> A f(5) P(m-1)\nP(m): m == 0 -> A\n'
+    )
+    shapes = (Terminal("G0", "M 0 0 L 1 1", "stroke:#000"),)
+    dialog = ReplaceDialog(grammar, shapes, core.shape_from_svg)
+    qtbot.addWidget(dialog)
+    assert dialog.target.currentData() == ("terminal", "A")
+    assert [dialog.source.itemText(i) for i in range(dialog.source.count())] == ["input element group 1"]
+    assert dialog.add_shape_from(str(corpus("sequence5.svg")))
+    choice = dialog.choice()
+    assert choice.kind == "terminal" and choice.target == "A" and choice.path.startswith("M")
+    dialog.target.setCurrentIndex(dialog.target.findText("P (non-terminal)"))
+    assert [dialog.source.itemText(i) for i in range(dialog.source.count())] == ["terminal A"]
+    assert not dialog.load_button.isEnabled()
+    assert not dialog.add_shape_from("/nonexistent/shape.svg")
+    assert "shape.svg" in dialog.error.text()

@@ -139,3 +139,32 @@ def test_signal_emit_keeps_reference_counts():
     for i in range(50):
         probe.ping.emit(i)
     assert sys.getrefcount(True) >= before
+
+
+def _stubborn(request, cancel, progress):
+    """Ignore the cancel token for a long time (a stage that never checks it)."""
+    progress("stuck", 0.0)
+    time.sleep(30)
+    return request
+
+
+def test_process_that_ignores_cancel_is_killed_and_start_never_blocks(qtbot):
+    from app import workers
+
+    compute = ProcessCompute(_stubborn)
+    try:
+        runner = LatestRunner(compute, name="lsys-test-stubborn")
+        stages = []
+        runner.progress.connect(lambda s, f: stages.append(s))
+        runner.submit("x")
+        qtbot.waitUntil(lambda: bool(stages), timeout=15000)
+        t0 = time.perf_counter()
+        compute.start()  # a job holds the process: returns at once
+        assert time.perf_counter() - t0 < 0.2
+        runner.cancel()
+        qtbot.waitUntil(lambda: not runner.busy, timeout=int((workers.CANCEL_GRACE_S + 5) * 1000))
+        assert time.perf_counter() - t0 < workers.CANCEL_GRACE_S + 3
+        assert compute._proc is None  # killed; the next request starts a new one
+        runner.shutdown()
+    finally:
+        compute.close()
