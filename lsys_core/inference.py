@@ -106,7 +106,7 @@ def _t_modules(alpha: Linear, d: Linear, s: Linear, beta: Linear) -> tuple[Modul
 #: (degrees; relative for distances and scales, which compound along a sequence).
 ANGLE_SNAP = 1e-5
 DISTANCE_SNAP = 1e-6
-SCALE_SNAP = 1e-8
+SCALE_SNAP = 5e-8
 
 
 def _nice(x: float, *, abs_tol: float = 0.0, rel_tol: float = 0.0) -> float:
