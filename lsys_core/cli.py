@@ -1,13 +1,17 @@
 """The ``lsys`` command: infer, symmetrize, derive and inspect L-systems without a GUI.
 
 Every failure prints one line ``lsys: error: …`` on stderr and exits 1 (2 for usage
-errors); outputs are written atomically, so a failed run leaves existing files untouched.
+errors, 130 when interrupted, 70 for an internal error, i.e. a bug: set ``LSYS_DEBUG=1``
+to see its traceback).  Outputs are checked before any work starts, computed in memory,
+and written together atomically: a failed run writes nothing and leaves existing files
+byte for byte untouched.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 from collections.abc import Sequence
@@ -17,6 +21,9 @@ from . import __version__
 from .errors import LsysError
 
 __all__ = ["main"]
+
+#: Largest accepted ``--limit``: beyond it a derivation's arrays and SVG text outgrow memory anyway.
+MAX_LIMIT = 100_000_000
 
 
 class _Progress:
@@ -128,9 +135,36 @@ def _load_rules(path: str):
     from .grammar import parse_grammar
 
     try:
-        return parse_grammar(_read_text(path))
+        return parse_grammar(_read_text(path), check_paths=True)
     except GrammarSyntaxError as e:
         raise LsysError(f"{path}:{e}") from None
+
+
+def _check_outputs(paths: list[str | None]) -> None:
+    """Fail fast, before any work, on outputs that cannot be written (missing folder, a folder, twice)."""
+    seen: dict[str, str] = {}
+    for path in filter(None, paths):
+        key = os.path.normcase(os.path.abspath(path))
+        if key in seen:
+            raise LsysError(f"cannot write {path}: the same file is given twice as an output")
+        seen[key] = path
+        target = Path(path)
+        parent = target.parent if str(target.parent) else Path(".")
+        if target.is_dir():
+            raise LsysError(f"cannot write {path}: Is a directory")
+        if not parent.is_dir():
+            reason = "Not a directory" if parent.exists() else "No such file or directory"
+            raise LsysError(f"cannot write {path}: {reason}")
+
+
+def _derive(grammar, **options):
+    """Derive quietly (numpy overflow warnings are not for the user; non-finite poses are checked on output)."""
+    import numpy as np
+
+    from .derive import derive
+
+    with np.errstate(all="ignore"):
+        return derive(grammar, **options)
 
 
 def _parse_randomize(text: str | None, seed: int):
@@ -167,15 +201,35 @@ def _parse_sets(items: list[str]) -> dict[str, float]:
     return out
 
 
-def _write_outputs(drawing, svg: str | None, png: str | None) -> None:
-    if svg:
-        from .svg.export import export_svg
+def _drawing_outputs(drawing, svg: str | None, png: str | None) -> list[tuple[str, str | bytes]]:
+    """Return the SVG and PNG files of a drawing as ``(path, content)``, computed in memory."""
+    import numpy as np
 
-        export_svg(drawing, svg)
-    if png:
-        from .render import render_png
+    out: list[tuple[str, str | bytes]] = []
+    if not (svg or png):
+        return out
+    from .svg.export import check_finite, drawing_to_svg
 
-        render_png(drawing, png)
+    check_finite(drawing)  # an overflowing grammar is an error, not an empty or broken picture
+    with np.errstate(all="ignore"):
+        if svg:
+            out.append((svg, drawing_to_svg(drawing)))
+        if png:
+            from .render import encode_png
+
+            try:
+                out.append((png, encode_png(drawing)))
+            except LsysError as e:
+                raise LsysError(f"cannot write {png}: {e}") from None
+    return out
+
+
+def _commit(files: list[tuple[str, str | bytes]]) -> None:
+    """Write all output files at once: all of them or none."""
+    from .io import write_files_atomic
+
+    if files:
+        write_files_atomic(files)
 
 
 def _infer_report(result, scene, drawing) -> dict:
@@ -202,13 +256,15 @@ def _infer_report(result, scene, drawing) -> dict:
 
 
 def _cmd_infer(args, progress: _Progress, symmetrize: bool = False) -> int:
-    from .derive import derive
     from .grammar import format_grammar
-    from .io import write_atomic
     from .pipeline import infer
     from .pipeline import symmetrize as sym_fn
     from .svg.parse import load_svg
 
+    if symmetrize:
+        _check_outputs([args.output, args.rules])
+    else:
+        _check_outputs([args.output, args.svg, args.png, args.report])
     t0 = time.perf_counter()
     scene = load_svg(args.input)
     t_import = time.perf_counter() - t0
@@ -219,26 +275,28 @@ def _cmd_infer(args, progress: _Progress, symmetrize: bool = False) -> int:
     fn = sym_fn if symmetrize else infer
     result = fn(scene, settings, progress=progress)
     t = time.perf_counter()
-    drawing = derive(result.grammar)
+    drawing = _derive(result.grammar)
     t_derive = time.perf_counter() - t
     result.stages["svg_import"] = t_import
     result.stages["derivation"] = t_derive
     progress.close()
     text = format_grammar(result.grammar)
+    files: list[tuple[str, str | bytes]] = []
     if symmetrize:
-        _write_outputs(drawing, args.output, None)
+        files += _drawing_outputs(drawing, args.output, None)
         if args.rules:
-            write_atomic(args.rules, text)
+            files.append((args.rules, text))
     else:
         if args.output:
-            write_atomic(args.output, text)
-        elif not args.report:
-            sys.stdout.write(text)
-        _write_outputs(drawing, args.svg, args.png)
+            files.append((args.output, text))
+        files += _drawing_outputs(drawing, args.svg, args.png)
         if args.report:
             rep = _infer_report(result, scene, drawing)
             rep["seconds"] = round(time.perf_counter() - t0, 4)
-            write_atomic(args.report, json.dumps(rep, indent=1, ensure_ascii=False) + "\n")
+            files.append((args.report, json.dumps(rep, indent=1, ensure_ascii=False) + "\n"))
+    _commit(files)
+    if not symmetrize and not args.output and not args.report:
+        sys.stdout.write(text)
     if args.verbose:
         for k, v in result.stages.items():
             print(f"lsys: {k:<12} {v * 1000:8.1f} ms", file=sys.stderr)
@@ -248,19 +306,22 @@ def _cmd_infer(args, progress: _Progress, symmetrize: bool = False) -> int:
 
 
 def _cmd_derive(args) -> int:
-    from .derive import DEFAULT_LIMIT, derive
+    from .derive import DEFAULT_LIMIT
     from .grammar import set_params
 
+    _check_outputs([args.output, args.png])
+    limit = DEFAULT_LIMIT if args.limit is None else args.limit
+    if not 1 <= limit <= MAX_LIMIT:
+        raise LsysError(f"--limit must be between 1 and {MAX_LIMIT:,}, got {limit:,}")
+    if args.seed < 0:
+        raise LsysError(f"--seed must be a whole number >= 0, got {args.seed}")
     g = _load_rules(args.rules)
     sets = _parse_sets(args.set)
     if sets:
         g = set_params(g, sets)
     rnd = _parse_randomize(args.randomize, args.seed)
-    limit = DEFAULT_LIMIT if args.limit is None else args.limit
-    if limit < 1:
-        raise LsysError("--limit must be at least 1")
-    drawing = derive(g, limit=limit, randomize=rnd)
-    _write_outputs(drawing, args.output, args.png)
+    drawing = _derive(g, limit=limit, randomize=rnd)
+    _commit(_drawing_outputs(drawing, args.output, args.png))
     if args.verbose:
         print(f"lsys: derived {len(drawing):,} elements", file=sys.stderr)
     return 0
@@ -300,6 +361,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         progress.close()
         print("lsys: error: out of memory", file=sys.stderr)
         return 1
+    except RecursionError:
+        progress.close()
+        print("lsys: error: the input is nested too deeply", file=sys.stderr)
+        return 1
+    except Exception as e:  # a bug: one line for the user, the traceback on request
+        progress.close()
+        if os.environ.get("LSYS_DEBUG"):
+            raise
+        detail = " ".join(str(e).split())[:200]
+        print(
+            f"lsys: error: internal error ({type(e).__name__}: {detail}); "
+            "please report this bug (LSYS_DEBUG=1 shows the traceback)",
+            file=sys.stderr,
+        )
+        return 70
 
 
 if __name__ == "__main__":

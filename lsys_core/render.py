@@ -28,7 +28,7 @@ from .errors import LsysError
 from .io import write_atomic
 from .model import Drawing
 
-__all__ = ["Renderer", "fit_view", "parse_style", "render", "render_png"]
+__all__ = ["MAX_PNG_PIXELS", "Renderer", "encode_png", "fit_view", "parse_style", "render", "render_png"]
 
 #: Colour of highlighted instances (RGBA).
 HIGHLIGHT = (255, 111, 0, 255)
@@ -38,6 +38,8 @@ DRAFT_HAIRLINE = 2.0
 CACHE_SIZE = 4096
 #: Largest image side accepted, in pixels.
 MAX_SIDE = 16384
+#: Most pixels of a PNG written by :func:`render_png` (larger sizes are scaled down, aspect kept).
+MAX_PNG_PIXELS = 40_000_000
 
 _VERB_MOVE, _VERB_LINE, _VERB_CUBIC, _VERB_CLOSE = 0, 1, 4, 5
 
@@ -378,9 +380,10 @@ class Renderer:
         symbol = np.asarray(drawing.symbol, dtype=np.intp).reshape(n)
         pa = np.asarray(drawing.a, dtype=complex).reshape(n)
         pb = np.asarray(drawing.b, dtype=complex).reshape(n)
-        # Device frame of every instance: view ∘ pose.
-        da = s * pa
-        db = s * pb + complex(tx, ty)
+        # Device frame of every instance: view ∘ pose (non-finite ones are culled below).
+        with np.errstate(invalid="ignore", over="ignore"):
+            da = s * pa
+            db = s * pb + complex(tx, ty)
         terms = [self._terminal(t.path, t.style) for t in drawing.terminals]
         visible = self._visible(terms, symbol, da, db, width, height)
         if draft:
@@ -407,9 +410,9 @@ class Renderer:
         )
         empty = np.array([t.geometry.verbs.size == 0 for t in terms] + [True])
         sym = np.where((symbol >= 0) & (symbol < len(terms)), symbol, len(terms))  # bad index: not drawn
-        rr = radius[sym] * np.abs(da) + 1.0
-        x, y = db.real, db.imag
-        with np.errstate(invalid="ignore"):
+        with np.errstate(invalid="ignore", over="ignore"):
+            rr = radius[sym] * np.abs(da) + 1.0
+            x, y = db.real, db.imag
             ok = (x + rr >= 0) & (x - rr <= width) & (y + rr >= 0) & (y - rr <= height)
         return ok & ~empty[sym] & np.isfinite(rr) & np.isfinite(db)
 
@@ -551,7 +554,42 @@ def _png_size(drawing: Drawing, width: int | None, height: int | None) -> tuple[
         h = max(1, round(w / aspect))
     else:
         w, h = int(width), int(height)
-    return min(w, MAX_SIDE), min(h, MAX_SIDE)
+    w, h = min(w, MAX_SIDE), min(h, MAX_SIDE)
+    if w * h > MAX_PNG_PIXELS:
+        shrink = math.sqrt(MAX_PNG_PIXELS / (w * h))
+        w, h = max(1, int(w * shrink)), max(1, int(h * shrink))
+    return w, h
+
+
+def encode_png(
+    drawing: Drawing,
+    width: int | None = None,
+    height: int | None = None,
+    *,
+    background: tuple[int, int, int, int] = (255, 255, 255, 0),
+) -> bytes:
+    """Render a drawing and return the bytes of a PNG file.
+
+    Without ``width`` and ``height`` the drawing's ``width``/``height`` (in px) or
+    viewBox size is used; with one of them the other follows the aspect ratio.  Sides
+    are capped at :data:`MAX_SIDE` and the image at :data:`MAX_PNG_PIXELS` pixels
+    (scaled down, aspect ratio kept), so an absurd canvas size cannot exhaust memory.
+
+    Raises
+    ------
+    LsysError
+        When the image cannot be encoded.
+    """
+    import skia
+
+    w, h = _png_size(drawing, width, height)
+    renderer = Renderer(w, h)
+    renderer.draw(drawing, None, True, False, background=background)
+    image = renderer._surface.makeImageSnapshot()
+    data = image.encodeToData(skia.EncodedImageFormat.kPNG, 100)
+    if data is None:
+        raise LsysError("PNG encoding failed")
+    return bytes(data)
 
 
 def render_png(
@@ -562,18 +600,9 @@ def render_png(
     *,
     background: tuple[int, int, int, int] = (255, 255, 255, 0),
 ) -> None:
-    """Render a drawing and write it as a PNG file atomically.
-
-    Without ``width`` and ``height`` the drawing's ``width``/``height`` (in px) or
-    viewBox size is used; with one of them the other follows the aspect ratio.
-    """
-    import skia
-
-    w, h = _png_size(drawing, width, height)
-    renderer = Renderer(w, h)
-    renderer.draw(drawing, None, True, False, background=background)
-    image = renderer._surface.makeImageSnapshot()
-    data = image.encodeToData(skia.EncodedImageFormat.kPNG, 100)
-    if data is None:
-        raise LsysError(f"cannot write {path}: PNG encoding failed")
-    write_atomic(path, bytes(data))
+    """Render a drawing and write it as a PNG file atomically (see :func:`encode_png`)."""
+    try:
+        data = encode_png(drawing, width, height, background=background)
+    except LsysError as exc:
+        raise LsysError(f"cannot write {path}: {exc}") from exc
+    write_atomic(path, data)

@@ -37,7 +37,7 @@ from .model import (
     Terminal,
     Turtle,
 )
-from .validate import KEYWORDS, RESERVED, Problem, count_text, find_problems
+from .validate import KEYWORDS, RESERVED, Problem, count_text, find_problems, path_problem
 
 __all__ = ["FORMAT_VERSION", "format_grammar", "parse_grammar"]
 
@@ -283,6 +283,7 @@ class _Line:
             first = self.st.places[("terminal", tok.text)]
             raise _fail(f"duplicate terminal '{tok.text}' (first on line {first[0]})", tok)
         self.st.places[("terminal", tok.text)] = tok.pos
+        self.st.places[("terminal", tok.text, "path")] = self.peek().pos
         path = self.string("the terminal's SVG path data")
         opts: dict[str, str] = {}
         while self.peek().kind == "name" and self.peek().text in ("style", "mirror"):
@@ -484,13 +485,17 @@ def _number(tok: _Tok) -> float:
     return v
 
 
-def parse_grammar(text: str) -> Grammar:
+def parse_grammar(text: str, *, check_paths: bool = False) -> Grammar:
     """Parse ``.lsys`` text into a validated :class:`~lsys_core.grammar.model.Grammar`.
 
     Parameters
     ----------
     text : str
         The whole file, starting with the ``lsys 1`` header (comments may come first).
+    check_paths : bool
+        Also require every terminal's path data to parse with finite coordinates
+        (see :func:`~lsys_core.grammar.validate.path_problem`); by default path data
+        is kept as given.
 
     Returns
     -------
@@ -526,6 +531,10 @@ def parse_grammar(text: str) -> Grammar:
     if problems:
         first = min(problems, key=lambda p: _place(p, st, end))
         raise _fail(first.message, _place(first, st, end))
+    if check_paths:
+        for t in g.terminals:
+            if (why := path_problem(t.path)) is not None:
+                raise _fail(f"terminal {t.name}: {why}", st.places[("terminal", t.name, "path")])
     return g
 
 

@@ -37,6 +37,7 @@ __all__ = [
     "Problem",
     "count_text",
     "find_problems",
+    "path_problem",
     "validate",
 ]
 
@@ -346,6 +347,38 @@ def _termination_problems(g: Grammar) -> list[Problem]:
                 why = f"the call {mod.name}(m) does not decrease m (write {mod.name}(m-1))"
                 out.append(Problem(f"rule {r.name} never terminates: {why}", "rule", r.name, ci, mi))
     return out
+
+
+def path_problem(d: str) -> str | None:
+    """Return why terminal path data cannot be drawn, or None.
+
+    Not part of :func:`find_problems`: path data is kept as given, and only a caller that
+    is about to draw or export (the ``lsys`` command) insists that it parses.
+
+    Parameters
+    ----------
+    d : str
+        SVG path data; empty data (a terminal that draws nothing) is fine.
+
+    Returns
+    -------
+    str or None
+        ``"invalid path data ..."`` or ``"path data has non-finite or huge coordinates"``.
+    """
+    from ..errors import SvgError
+    from ..svg.parse import MAX_COORD
+    from ..svg.pathdata import cubics_from_d
+
+    if not d.strip():
+        return None
+    try:
+        cubics, _, _ = cubics_from_d(d)
+    except SvgError as exc:
+        return str(exc)
+    with np.errstate(invalid="ignore"):
+        if cubics.size and not (np.isfinite(cubics).all() and np.abs(cubics).max() <= MAX_COORD):
+            return "path data has non-finite or huge coordinates"
+    return None
 
 
 def count_text(a: Count) -> str:

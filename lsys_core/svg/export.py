@@ -14,11 +14,12 @@ from xml.sax.saxutils import escape
 
 import numpy as np
 
+from ..errors import LsysError
 from ..io import write_atomic
 from ..model import Drawing
 from .pathdata import cubics_from_d
 
-__all__ = ["drawing_bounds", "drawing_to_svg", "export_svg", "terminal_points"]
+__all__ = ["check_finite", "drawing_bounds", "drawing_to_svg", "export_svg", "terminal_points"]
 
 #: Significant digits of pose matrices and of the computed canvas.
 DIGITS = 7
@@ -83,10 +84,11 @@ def drawing_bounds(drawing: Drawing, *, chunk: int = 1_000_000) -> tuple[float, 
         step = max(1, chunk // p.size)
         for s in range(0, idx.size, step):
             sel = idx[s : s + step]
-            z = a[sel, None] * p[None, :] + b[sel, None]
-            r = pad * np.abs(a[sel])
-            lo = np.minimum(lo, [np.min(z.real.min(axis=1) - r), np.min(z.imag.min(axis=1) - r)])
-            hi = np.maximum(hi, [np.max(z.real.max(axis=1) + r), np.max(z.imag.max(axis=1) + r)])
+            with np.errstate(invalid="ignore", over="ignore"):  # non-finite bounds give None below
+                z = a[sel, None] * p[None, :] + b[sel, None]
+                r = pad * np.abs(a[sel])
+                lo = np.minimum(lo, [np.min(z.real.min(axis=1) - r), np.min(z.imag.min(axis=1) - r)])
+                hi = np.maximum(hi, [np.max(z.real.max(axis=1) + r), np.max(z.imag.max(axis=1) + r)])
     if not np.all(np.isfinite(lo)) or not np.all(np.isfinite(hi)):
         return None
     return (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
@@ -116,8 +118,10 @@ def drawing_to_svg(drawing: Drawing) -> str:
     Instance ``i`` draws ``drawing.terminals[drawing.symbol[i]]`` mapped by
     ``z -> a[i] * z + b[i]``, written as ``matrix(Re a, Im a, -Im a, Re a, Re b, Im b)``.
     The root ``<svg>`` gets the drawing's viewBox and size; without a viewBox one
-    is computed from the instances' bounds plus a small margin.
+    is computed from the instances' bounds plus a small margin.  Raises
+    :class:`~lsys_core.errors.LsysError` when a pose is not finite.
     """
+    check_finite(drawing)
     vb, size = _canvas(drawing)
     head = (
         '<?xml version="1.0" encoding="UTF-8"?>\n'
@@ -147,6 +151,25 @@ def drawing_to_svg(drawing: Drawing) -> str:
     values += 0.0  # no "-0"
     template = "".join(np.asarray(formats, dtype=object)[np.asarray(drawing.symbol, dtype=np.intp)].tolist())
     return head + template % tuple(values.ravel().tolist()) + "</svg>\n"
+
+
+def check_finite(drawing: Drawing) -> None:
+    """Raise :class:`~lsys_core.errors.LsysError` if any pose is not finite (no file can hold it).
+
+    Overflowing scales or distances in a grammar give infinite or NaN poses; this names
+    how many instances are affected.
+    """
+    n = len(drawing)
+    if n == 0:
+        return
+    a = np.asarray(drawing.a, dtype=complex).reshape(n)
+    b = np.asarray(drawing.b, dtype=complex).reshape(n)
+    bad = ~(np.isfinite(a) & np.isfinite(b))
+    if bad.any():
+        raise LsysError(
+            f"{int(bad.sum()):,} of {n:,} instances have non-finite positions or sizes "
+            "(a scale or distance overflows); lower the counter m, the scale or the distances"
+        )
 
 
 def export_svg(drawing: Drawing, path: str | os.PathLike) -> None:

@@ -71,7 +71,7 @@ _INTERNAL_SUBSET = re.compile(rb"<!DOCTYPE[^\[>]*\[")
 _LENGTH = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(?:px|pt|pc|mm|cm|in|%)?\s*")
 #: An opacity declaration in a ``style`` attribute or a style sheet.
 _OPACITY_DECL = re.compile(r"(?i)((?<![\w-])(?:fill-|stroke-)?opacity\s*:\s*)([^;}!\s]+)")
-OPACITY_ATTRS = ("opacity", "fill-opacity", "stroke-opacity")
+_OPACITY_ATTRS = ("opacity", "fill-opacity", "stroke-opacity")
 #: Exceptions svgelements raises on values it cannot handle.
 _SVGELEMENTS_ERRORS = (
     ValueError,
@@ -392,10 +392,10 @@ def _clamp_decl(mt: re.Match) -> str:
 
 
 def _clamp_opacities(el, tag: str) -> None:
-    """Clamp infinite opacities in attributes, ``style`` and style sheets to [0, 1] (as CSS does)."""
+    """Clamp opacities in attributes, ``style`` and style sheets to [0, 1], as CSS does."""
     attrib = el.attrib
     if attrib:
-        for key in OPACITY_ATTRS:
+        for key in _OPACITY_ATTRS:
             value = attrib.get(key)
             if value is not None and (fixed := _clamp_opacity_text(value)) is not None:
                 attrib[key] = fixed
@@ -420,12 +420,15 @@ def _drop_unusable_viewport(el, notes: list[str]) -> None:
     vb = el.get("viewBox")
     if vb is not None and _parse_viewbox(vb) is None:
         del el.attrib["viewBox"]
-        notes.append(f"ignored the viewBox {_snippet(vb)} of <svg>: it needs 4 numbers with width, height > 0")
+        notes.append(
+            f"ignored the viewBox {_snippet(vb)} of <svg>: it needs 4 numbers with width, height > 0"
+        )
     for key in ("width", "height"):
         value = el.get(key)
         if value is not None and not _usable_length(value):
             del el.attrib[key]
-            notes.append(f"ignored the {key} {_snippet(value)} of <svg>: it must be a positive length in px, pt, pc, mm, cm, in or %")
+            unit = "a positive length in px, pt, pc, mm, cm, in or %"
+            notes.append(f"ignored the {key} {_snippet(value)} of <svg>: it must be {unit}")
 
 
 def _snippet(text: str, n: int = 40) -> str:

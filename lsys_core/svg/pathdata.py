@@ -339,12 +339,19 @@ def cubics_from_d(d: str) -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
         return _to_arrays(raw)
     from svgelements import Path
 
+    snippet = d if len(d) <= 40 else d[:37] + "..."
     try:
-        path = Path(d)
-    except (ValueError, TypeError, IndexError) as exc:
-        snippet = d if len(d) <= 40 else d[:37] + "..."
+        return cubics_from_path(Path(d))
+    except (
+        ValueError,
+        TypeError,
+        IndexError,
+        KeyError,
+        AttributeError,
+        ZeroDivisionError,
+        OverflowError,
+    ) as exc:
         raise SvgError(f"invalid path data {snippet!r}") from exc
-    return cubics_from_path(path)
 
 
 def _collinear_thirds(cubics: np.ndarray, tol: float) -> np.ndarray:
