@@ -67,6 +67,19 @@ def _proximity(ps: PairSpace, n_nodes: int, radius: np.ndarray) -> np.ndarray:
 
 
 def find_candidates(bld, sym, a, b, ps: PairSpace, radius: np.ndarray) -> list[Candidate]:
+    """Return the candidate rules of one level, with their importance terms ``n, h, φ, l``.
+
+    Parameters
+    ----------
+    bld
+        The rule builder (bandwidths ``bld.tol``, symbol sizes, shape similarity ``bld.phi``).
+    sym, a, b
+        Symbol and frame of every live node.
+    ps : PairSpace
+        The pairs of this level and their relative transforms.
+    radius : ndarray
+        Radius of every live node's geometry.
+    """
     if len(ps) == 0:
         return []
     tol = bld.tol
@@ -90,6 +103,8 @@ def find_candidates(bld, sym, a, b, ps: PairSpace, radius: np.ndarray) -> list[C
     clusters = _group_indices(labels)
     seq_by_space: dict[tuple[int, int], list[tuple[np.ndarray, dict]]] = {}
     for idx in clusters:
+        if idx.size < 2:
+            continue  # a single pair repeats nothing
         si, sj = int(sym[ps.src[idx[0]]]), int(sym[ps.dst[idx[0]]])
         cost = np.linalg.norm(emb[idx, :5] - emb[idx, :5].mean(0), axis=1)
         src, dst = ps.src[idx], ps.dst[idx]

@@ -44,6 +44,12 @@ def _row_keys(cells: np.ndarray) -> np.ndarray:
     return h.view(np.int64)
 
 
+def _ball_pairs(query: np.ndarray, tree: cKDTree, r: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Return ``(i, j)`` for every point ``j`` of ``tree`` within ``r`` of ``query[i]`` (vectorised)."""
+    pairs = cKDTree(query).sparse_distance_matrix(tree, r, output_type="ndarray")
+    return pairs["i"].astype(np.intp), pairs["j"].astype(np.intp)
+
+
 def mean_shift(
     points: np.ndarray, *, max_iter: int = 30, min_count: int = 1
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -81,33 +87,38 @@ def mean_shift(
     w = counts.astype(float)
     tree = cKDTree(cent)
     seeds = cent.copy()
+    active = np.arange(len(seeds))
     for _ in range(max_iter):
-        nbrs = tree.query_ball_point(seeds, r=1.0)
-        lens = np.fromiter((len(x) for x in nbrs), int, len(nbrs))
-        flat = np.fromiter((j for x in nbrs for j in x), int, int(lens.sum()))
-        owner = np.repeat(np.arange(len(nbrs)), lens)
+        owner, flat = _ball_pairs(seeds[active], tree)
         ws = w[flat]
-        num = np.zeros_like(seeds)
-        np.add.at(num, owner, cent[flat] * ws[:, None])
-        den = np.bincount(owner, weights=ws, minlength=len(nbrs))
+        dim = seeds.shape[1]
+        num = np.column_stack(
+            [np.bincount(owner, weights=cent[flat, k] * ws, minlength=active.size) for k in range(dim)]
+        )
+        den = np.bincount(owner, weights=ws, minlength=active.size)
         new = num / np.maximum(den, 1e-300)[:, None]
-        shift = np.abs(new - seeds).max() if new.size else 0.0
-        seeds = new
-        if shift < 1e-4:
+        moved = np.abs(new - seeds[active]).max(axis=1) >= 1e-4
+        seeds[active] = new
+        active = active[moved]  # converged seeds stay where they are
+        if active.size == 0:
             break
     # Support of every converged seed, then merge modes closer than half a bandwidth (strongest first).
-    support = np.array([w[x].sum() for x in tree.query_ball_point(seeds, r=1.0)])
+    owner, flat = _ball_pairs(seeds, tree)
+    support = np.bincount(owner, weights=w[flat], minlength=len(seeds))
     order = np.argsort(-support, kind="stable")
-    modes: list[np.ndarray] = []
-    for i in order:
-        if support[i] < min_count:
+    order = order[support[order] >= min_count]
+    # Greedy suppression, strongest first: a seed within half a bandwidth of a kept mode merges into it.
+    close = cKDTree(seeds).query_ball_point(seeds[order], r=0.5)
+    suppressed = np.zeros(len(seeds), bool)
+    keep_idx = []
+    for i, near in zip(order.tolist(), close, strict=True):
+        if suppressed[i]:
             continue
-        if modes and np.min(np.linalg.norm(np.asarray(modes) - seeds[i], axis=1)) < 0.5:
-            continue
-        modes.append(seeds[i])
-    if not modes:
+        keep_idx.append(i)
+        suppressed[near] = True
+    if not keep_idx:
         return np.full(n, -1), np.zeros((0, pts.shape[1]))
-    mode_arr = np.asarray(modes)
+    mode_arr = seeds[keep_idx]
     dist, lab = cKDTree(mode_arr).query(pts, k=1)
     lab = np.where(dist <= 1.0, lab, -1)
     # Points farther than a bandwidth from every mode form their own singleton clusters.

@@ -243,6 +243,11 @@ def derive(
     Drawing
         Terminal instances with their poses, in a deterministic order.
     """
+    with np.errstate(all="ignore"):
+        return _derive(grammar, limit, randomize, cancel)
+
+
+def _derive(grammar: Grammar, limit: int, randomize: Randomize | None, cancel: CancelToken | None) -> Drawing:
     compiled, _, _ = _compile(grammar)
     emitter = _Emitter(limit)
     work_budget = 4 * max(limit, 1000)
@@ -271,6 +276,7 @@ def derive(
             if a_base is not None:
                 a, b = a_base * a, a_base * b + b_base
             emitter.reserve(a.size, where)
+            _check_finite(a, b, where)
             emitter.add(term, a, b, rule)
 
     # The axiom: one item, no counter, not perturbed.
@@ -311,6 +317,14 @@ def derive(
                 continue
             _unroll(interp, emit, push, rule, r, ci, case, ms, as_, bs, where, work_budget - work)
     return _collect(grammar, emitter)
+
+
+def _check_finite(a: np.ndarray, b: np.ndarray, where: str) -> None:
+    """Raise :class:`LimitError` when poses left the floating-point range (or became NaN)."""
+    if not (np.isfinite(a).all() and np.isfinite(b).all()):
+        raise LimitError(
+            f"derivation overflows in {where}: its scales or distances grow beyond floating-point range"
+        )
 
 
 def _compile_axiom(grammar: Grammar) -> list[_Op]:

@@ -102,6 +102,14 @@ def _t_modules(alpha: Linear, d: Linear, s: Linear, beta: Linear) -> tuple[Modul
     return tuple(out)
 
 
+#: Levels of the hierarchy at most (each level codes at least one repetition).
+MAX_LEVELS = 100
+#: Scenes with more live nodes than this ignore candidates that repeat only twice (see :func:`_chance`).
+CHANCE_SCENE = 100
+#: A best candidate covering less than this share of the nodes is applied together with all
+#: other candidates on disjoint nodes (see :func:`_batch`).
+WEAK_COVER = 0.05
+
 #: Written values are the shortest decimals within these tolerances of the measured ones
 #: (degrees; relative for distances and scales, which compound along a sequence).
 ANGLE_SNAP = 1e-5
@@ -232,6 +240,15 @@ def build_hierarchy(
     clock = timer if timer is not None else {}
     for k in ("transforms", "clustering", "rules"):
         clock.setdefault(k, 0.0)
+    dup = _duplicates(bld, sym, a, b)
+    if dup:
+        level += 1
+        for k, cand in enumerate(dup):
+            sym, a, b, center, radius, members, mapping = _apply(
+                bld, cand, sym, a, b, center, radius, members, node_rule
+            )
+            for later in dup[k + 1 :]:
+                _remap(later, mapping)
     while a.size > 1:
         check(cancel)
         report(progress, "rules", 1.0 - (a.size - 1) / max(n0 - 1, 1))
@@ -240,15 +257,24 @@ def build_hierarchy(
         t1 = time.perf_counter()
         cands = find_candidates(bld, sym, a, b, ps, radius)
         t2 = time.perf_counter()
-        if cands:
+        if cands and level < MAX_LEVELS:
             first = np.array([m.min() for m in members])
             for c in cands:
                 c.extra["start"] = float(np.mean([first[g[0]] for g in c.groups]))
             best = _select(cands, bld.weights)
-            level += 1
-            sym, a, b, center, radius, members = _apply(
-                bld, best, sym, a, b, center, radius, members, node_rule
-            )
+            if _chance(best, a.size):
+                cands = []  # only coincidences left: place the remaining nodes as they are
+            else:
+                chosen = _batch(best, cands, a.size)
+                level += 1
+                for k, cand in enumerate(chosen):
+                    sym, a, b, center, radius, members, mapping = _apply(
+                        bld, cand, sym, a, b, center, radius, members, node_rule
+                    )
+                    for later in chosen[k + 1 :]:
+                        _remap(later, mapping)
+        else:
+            cands = []
         clock["transforms"] += t1 - t0
         clock["clustering"] += t2 - t1
         clock["rules"] += time.perf_counter() - t2
@@ -276,6 +302,72 @@ def build_hierarchy(
             node_rule[mem[node_rule[mem] < 0]] = len(bld.rules) - 1
     report(progress, "rules", 1.0)
     return Hierarchy(bld.rules, axiom, level, node_rule, bld.log, closed=a.size == 1)
+
+
+def _duplicates(bld: _Builder, sym: np.ndarray, a: np.ndarray, b: np.ndarray) -> list[Candidate]:
+    """Sequences with the identity transform for elements drawn several times at one pose.
+
+    Stacked copies would otherwise pair with each other in arbitrary ways; coding each
+    stack as ``P(m) -> A P(m-1)`` first keeps them (nothing is lost) and out of the way.
+    """
+    sizes = np.array([s.size for s in bld.syms])[sym]
+    q = np.maximum(sizes * 1e-6, 1e-9)
+    key = np.column_stack(
+        [sym, np.round(b.real / q), np.round(b.imag / q), np.round(a.real / 1e-6), np.round(a.imag / 1e-6)]
+    )
+    _, inv, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    inv = inv.ravel()
+    out: dict[int, Candidate] = {}
+    for g in np.flatnonzero(counts >= 2):
+        nodes = np.flatnonzero(inv == g).tolist()
+        s = int(sym[nodes[0]])
+        cand = out.setdefault(s, Candidate("seq", (s, s), [], (1 + 0j, 0j)))
+        cand.groups.append(nodes)
+    return list(out.values())
+
+
+def _chance(best: Candidate, n_nodes: int) -> bool:
+    """Whether the best candidate looks like a coincidence in a large scene.
+
+    Two repetitions of a transform among hundreds of unrelated elements happen by chance;
+    coding them would add rules without describing any structure.
+    """
+    repeats = len(best.groups) if best.kind != "seq" else sum(len(g) - 1 for g in best.groups)
+    return n_nodes > CHANCE_SCENE and repeats < 3 and best.covered < WEAK_COVER * n_nodes
+
+
+def _batch(best: Candidate, cands: list[Candidate], n_nodes: int) -> list[Candidate]:
+    """Return the candidates to apply at this level: the best one, or many weak ones at once.
+
+    When the most important candidate covers only a small part of the scene (chance
+    coincidences among clutter or duplicates), every other candidate on disjoint nodes is
+    applied in the same level, in order of importance, so the number of levels stays small.
+    """
+    if best.covered >= WEAK_COVER * n_nodes:
+        return [best]
+    taken = np.zeros(n_nodes, bool)
+    out = []
+    for c in sorted(cands, key=lambda c: -c.score):
+        nodes = _nodes_of(c)
+        if taken[nodes].any():
+            continue
+        taken[nodes] = True
+        out.append(c)
+    return out
+
+
+def _nodes_of(c: Candidate) -> np.ndarray:
+    if c.kind == "branch":
+        return np.concatenate([t[2] for t in c.groups])
+    return np.concatenate([np.asarray(g) for g in c.groups])
+
+
+def _remap(c: Candidate, mapping: np.ndarray) -> None:
+    """Rewrite a candidate's node indices after another candidate was applied."""
+    if c.kind == "branch":
+        c.groups = [(int(mapping[r]), d, mapping[nodes]) for r, d, nodes in c.groups]
+    else:
+        c.groups = [[int(mapping[i]) for i in g] for g in c.groups]
 
 
 def _select(cands: list[Candidate], w: Weights) -> Candidate:
@@ -369,4 +461,6 @@ def _apply(bld: _Builder, c: Candidate, sym, a, b, center, radius, members, node
     center = np.concatenate([center[kept], np.array(add_c, complex)])
     radius = np.concatenate([radius[kept], np.array(add_r, float)])
     members = [members[i] for i in kept] + add_m
-    return sym, a, b, center, radius, members
+    mapping = np.full(keep.size, -1)
+    mapping[kept] = np.arange(kept.size)
+    return sym, a, b, center, radius, members, mapping

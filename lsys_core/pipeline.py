@@ -32,6 +32,8 @@ INFER_ERROR = 0.004
 #: Largest deviation (relative to the scene's diagonal) of an element from the terminal
 #: drawn in its place; elements farther from their group's shape get a terminal of their own.
 SHAPE_ERROR = 0.002
+#: Scenes with more elements than this try fewer relaxed tolerances (see :func:`_factors`).
+LARGE_SCENE = 1000
 #: A relaxed grammar may deviate up to this much if it needs at most :data:`JITTER_GAIN`
 #: times the productions of the exact one (jittered repetitions, paper Fig. 10).
 JITTER_ERROR = 0.025
@@ -131,11 +133,18 @@ def _diagonal(center: np.ndarray, radius: np.ndarray) -> float:
     return max(float(np.hypot(*(hi - lo))), 1e-12)
 
 
-def _factors(settings: InferenceSettings, symmetrizing: bool) -> list[float]:
-    """Bandwidth factors to try: the user's tolerance first, then relaxed ones."""
+def _factors(settings: InferenceSettings, symmetrizing: bool, n: int) -> list[float]:
+    """Bandwidth factors to try: the user's tolerance first, then relaxed ones.
+
+    Large scenes try fewer relaxed factors: each try is a whole rule generation.
+    """
     if symmetrizing:
-        return [settings.tolerance * f for f in (1.0, 2.0)]
-    return [settings.tolerance * f for f in (1.0, 3.0, 5.0, 9.0, 15.0)]
+        steps = (1.0, 2.0)
+    elif n <= LARGE_SCENE:
+        steps = (1.0, 3.0, 5.0, 9.0, 15.0)
+    else:
+        steps = (1.0, 5.0)
+    return [settings.tolerance * f for f in steps]
 
 
 def reproduction_error(inst: Instancing, sizes: np.ndarray, drawing) -> float:
@@ -231,7 +240,7 @@ def infer(
     shape_sim = _shape_similarity(inst, cancel)
     best = None
     first_count: int | None = None
-    for factor in _factors(settings, symmetrizing):
+    for factor in _factors(settings, symmetrizing, len(scene.elements)):
         check(cancel)
         hier = build_hierarchy(
             [t.name for t in inst.terminals],
