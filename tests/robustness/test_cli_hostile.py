@@ -32,7 +32,7 @@ from .generators import ROOT, hostile_rules, hostile_svgs
 MEMORY_LIMIT = 2 << 30
 TIMEOUT = 30.0
 PRECIOUS = b"precious work \x00\xff that must survive\n"
-GOOD_RULES = (ROOT / "resources" / "examples" / "helix.lsys").read_text(encoding="utf-8")
+GOOD_RULES = (ROOT / "tests" / "data" / "helix_truth.lsys").read_text(encoding="utf-8")
 SVG_OUTPUTS = ("r.lsys", "o.svg", "o.png", "rep.json")
 INFER = ("infer", "in.svg", "-o", "r.lsys", "--svg", "o.svg", "--png", "o.png", "--report", "rep.json")
 DERIVE = ("derive", "r.lsys", "-o", "o.svg", "--png", "o.png")
@@ -154,7 +154,7 @@ def _cases() -> list[Case]:
     cases += [
         derive("set-m-1e9", ("--set", "m=1000000000"), "element limit"),
         derive("set-m-nan", ("--set", "m=nan"), "finite number"),
-        derive("set-scale-0", ("--set", "axiom.0.2.v=0"), "scale must be positive"),
+        derive("set-scale-0", ("--set", "P.0.2.v=0"), "scale must be positive"),
         derive("set-unknown", ("--set", "nope=1"), "unknown parameter 'nope'"),
         derive("set-junk", ("--set", "m=abc"), "must be a number"),
         derive("randomize-nan", ("--randomize", "angle=nan"), "--randomize"),
