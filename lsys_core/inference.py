@@ -199,7 +199,7 @@ def build_hierarchy(
     weights: Weights = Weights(),
     tol: Tolerance = Tolerance(),
     similarity: np.ndarray | None = None,
-    neighbours: int = 12,
+    neighbours: int = 24,
     cancel: CancelToken | None = None,
     progress: Progress | None = None,
     timer: dict[str, float] | None = None,

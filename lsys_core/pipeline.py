@@ -65,7 +65,7 @@ class InferenceSettings:
     wl: float = Weights.wl
     similarity: float = 0.6
     tolerance: float = 1.0
-    neighbours: int = 12
+    neighbours: int = 24
 
     def relaxed(self, factor: float = RELAXED) -> InferenceSettings:
         """Return these settings with the tolerance multiplied by ``factor`` (for symmetrization)."""
