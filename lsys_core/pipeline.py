@@ -19,6 +19,7 @@ from .fidelity import split_unfaithful
 from .grammar.model import Grammar
 from .inference import Tolerance, Weights, build_hierarchy
 from .model import Instancing, Scene
+from .orientation import unwrap_symmetric
 from .pivots import estimate_pivots, recenter
 from .postprocess import simplify
 
@@ -233,6 +234,7 @@ def infer(
     sizes = np.zeros(len(inst.terminals))
     np.maximum.at(sizes, inst.group, radius / np.maximum(np.abs(inst.a), 1e-300))
     t = time.perf_counter()
+    inst = unwrap_symmetric(inst)
     inst = recenter(inst, estimate_pivots(inst, sizes))
     stages["pivots"] = time.perf_counter() - t
     weights = Weights(settings.wn, settings.wh, settings.wphi, settings.wl)

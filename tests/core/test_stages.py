@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -73,3 +75,16 @@ def test_progress_reports_stages() -> None:
     stages = {s for s, _ in seen}
     assert {"similarity", "rules"} <= stages
     assert all(0.0 <= f <= 1.0 for _, f in seen)
+
+
+def test_ring_of_symmetric_bars_is_one_sequence() -> None:
+    """Bars look the same turned by 180°: their rotations are unwrapped around the ring."""
+    pts = [-1 - 2.5j, 1 - 2.5j, 1 + 2.5j, -1 + 2.5j, -1 - 2.5j]
+    bar = np.array([[p, p + (q - p) / 3, p + 2 * (q - p) / 3, q] for p, q in itertools.pairwise(pts)])
+    frames = [
+        (np.exp(1j * np.deg2rad(30 * k)), 12 + 12j + 9 * np.exp(1j * np.deg2rad(30 * k - 90)))
+        for k in range(12)
+    ]
+    r = infer(scene(place(bar, frames, style="fill:#000")))
+    assert r.grammar.production_count == 2
+    assert r.stages["reproduction_error"] < 1e-6

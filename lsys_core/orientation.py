@@ -1,0 +1,63 @@
+"""Choose the rotations of symmetric elements so that their arrangement reads as regular.
+
+A rectangle turned by 120° looks the same as one turned by -60°: for a shape with k-fold
+symmetry the rotation of an instance is only known modulo 360/k, and the similarity stage
+reports the representative in (-180/k, 180/k].  In a ring of bars turned 30° apart that
+wraps from 90° to -60° half way round, and the constant transform between neighbours is
+lost.  Here rotations are *unwrapped* like a phase: along a minimum spanning tree of each
+group's nearest-neighbour graph, every instance takes the equivalent rotation closest to its
+parent's, so a constant step stays constant.  The drawing does not change.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import breadth_first_order, connected_components, minimum_spanning_tree
+from scipy.spatial import cKDTree
+
+from .model import Instancing
+
+__all__ = ["unwrap_symmetric"]
+
+
+def _unwrap_group(a: np.ndarray, b: np.ndarray, period: float) -> np.ndarray:
+    """Return the rotations (radians) of one group's instances, unwrapped along an MST."""
+    n = a.size
+    theta = np.angle(a)
+    if n < 2:
+        return theta
+    k = min(6, n - 1)
+    pts = np.column_stack([b.real, b.imag])
+    dist, idx = cKDTree(pts).query(pts, k=k + 1)
+    rows = np.repeat(np.arange(n), k)
+    cols = idx[:, 1:].ravel()
+    w = dist[:, 1:].ravel() + 1e-12  # zero weights would be dropped from the sparse graph
+    graph = coo_matrix((w, (rows, cols)), shape=(n, n)).tocsr()
+    tree = minimum_spanning_tree(graph)
+    tree = tree + tree.T
+    out = theta.copy()
+    _, comp = connected_components(tree, directed=False)
+    for c in np.unique(comp):
+        root = int(np.flatnonzero(comp == c)[0])
+        order, parent = breadth_first_order(tree, root, directed=False, return_predecessors=True)
+        for node in order[1:]:
+            p = out[parent[node]]
+            out[node] = p + np.mod(theta[node] - p + period / 2, period) - period / 2
+    return out
+
+
+def unwrap_symmetric(inst: Instancing) -> Instancing:
+    """Return ``inst`` with the rotations of k-fold symmetric terminals unwrapped (see module doc)."""
+    a = inst.a.copy()
+    for g, order in enumerate(np.asarray(inst.symmetry)):
+        if order < 2:
+            continue  # no symmetry, or continuous (a circle: every rotation is the same)
+        sel = np.flatnonzero(inst.group == g)
+        if sel.size < 2:
+            continue
+        theta = _unwrap_group(inst.a[sel], inst.b[sel], 2 * np.pi / order)
+        a[sel] = np.abs(inst.a[sel]) * np.exp(1j * theta)
+    return replace(inst, a=a)
