@@ -339,13 +339,25 @@ def _edge_chains(e1: np.ndarray, e2: np.ndarray) -> list[list[int]]:
     nxt = dict(zip(e1[keep].tolist(), e2[keep].tolist(), strict=True))
     has_prev = set(nxt.values())
     chains = []
+    seen: set[int] = set()
     for s0 in nxt:
         if s0 in has_prev:
             continue
         ch = [s0]
         while ch[-1] in nxt:
             ch.append(nxt[ch[-1]])
+        seen.update(ch)
         chains.append(ch)
+    # Closed loops (a ring of dots): cut each before its smallest pair and drop the closing one.
+    for s0 in sorted(nxt):
+        if s0 in seen:
+            continue
+        cyc = [s0]
+        while nxt.get(cyc[-1], s0) != s0 and len(cyc) <= len(nxt):
+            cyc.append(nxt[cyc[-1]])
+        seen.update(cyc)
+        if len(cyc) > 2:
+            chains.append(cyc[:-1])
     return chains
 
 
