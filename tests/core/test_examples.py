@@ -7,9 +7,7 @@ import re
 import shutil
 from pathlib import Path
 
-import numpy as np
 import pytest
-from scipy.spatial import cKDTree
 
 from lsys_core.derive import Randomize, derive
 from lsys_core.grammar import parse_grammar
@@ -17,7 +15,7 @@ from lsys_core.model import Scene
 from lsys_core.pipeline import symmetrize
 from lsys_core.svg.export import drawing_to_svg
 from lsys_core.svg.parse import load_svg, parse_svg
-from lsys_core.svg.pathdata import sample_cubics
+from lsys_core.testing import hausdorff_rel, regularity
 
 from .shared import ROOT
 
@@ -27,28 +25,6 @@ NAMES = sorted(p.stem for p in EXAMPLES.glob("*.svg"))
 #: Reproduction tolerance (Hausdorff distance / bounding-box diagonal), as for the corpus.
 TOL = 0.005
 JITTER_TOL = 0.03
-
-
-def scene_points(scene: Scene, per_segment: int = 8) -> np.ndarray:
-    """Return points sampled along every element of ``scene`` as an ``(n, 2)`` array."""
-    cubics = np.concatenate([e.cubics for e in scene.elements])
-    pts = sample_cubics(cubics, per_segment)
-    return np.column_stack([pts.real, pts.imag])
-
-
-def hausdorff_rel(a: Scene, b: Scene) -> float:
-    """Return the symmetric Hausdorff distance of two scenes over ``a``'s bounding-box diagonal."""
-    pa, pb = scene_points(a), scene_points(b)
-    diag = float(np.linalg.norm(pa.max(0) - pa.min(0)))
-    h = max(cKDTree(pb).query(pa)[0].max(), cKDTree(pa).query(pb)[0].max())
-    return float(h / diag)
-
-
-def regularity(scene: Scene) -> float:
-    """Return the spread (std / mean) of nearest-neighbour distances between element centres."""
-    c = np.array([e.cubics.mean() for e in scene.elements])
-    d, _ = cKDTree(np.column_stack([c.real, c.imag])).query(np.column_stack([c.real, c.imag]), k=2)
-    return float(d[:, 1].std() / d[:, 1].mean())
 
 
 def rules(path: Path):
