@@ -148,6 +148,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     QCoreApplication.setOrganizationName("lsys-editor")
     QCoreApplication.setApplicationName("lsys-editor")
     app = QApplication.instance() or QApplication([sys.argv[0]])
+    _set_identity(app)
 
     from .main_window import MainWindow
 
@@ -174,6 +175,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         return app.exec()
     finally:
         window.shutdown()
+
+
+def _set_identity(app) -> None:
+    """Give the windows the application icon and link them to the desktop entry."""
+    from PySide6.QtGui import QGuiApplication, QIcon
+
+    from .resources import APP_ID, icon_path
+
+    QGuiApplication.setDesktopFileName(APP_ID)
+    icon = icon_path()
+    if icon is not None:
+        app.setWindowIcon(QIcon(str(icon)))
 
 
 if __name__ == "__main__":

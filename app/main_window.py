@@ -34,6 +34,7 @@ from .message_bar import MessageBar
 from .params_panel import ParamsPanel
 from .recent_files import RecentFiles
 from .recovery import Recovery
+from .resources import examples
 from .rules_panel import RulesPanel
 
 __all__ = ["MainWindow"]
@@ -189,6 +190,12 @@ class MainWindow(QMainWindow):
         file_menu.addAction(self.act_open)
         self.recent_menu = file_menu.addMenu("Open &Recent")
         self.recent.attach(self.recent_menu)
+        self.examples_menu = file_menu.addMenu("Open E&xample")
+        for path in examples():
+            act = self.examples_menu.addAction(path.stem.replace("-", " ").capitalize())
+            act.setToolTip(str(path))
+            act.triggered.connect(lambda _=False, p=str(path): self.open_path(p))
+        self.examples_menu.setEnabled(bool(self.examples_menu.actions()))
         file_menu.addSeparator()
         for act in (self.act_save, self.act_save_as):
             file_menu.addAction(act)
