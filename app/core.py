@@ -93,10 +93,10 @@ def randomize_from_dict(values: dict[str, Any] | None) -> Randomize | None:
 
 
 def parse_grammar(text: str) -> Any:
-    """Parse ``.lsys`` text (raises ``GrammarSyntaxError`` with line and column)."""
+    """Parse ``.lsys`` text, terminal path data included (raises ``GrammarSyntaxError`` with line and column)."""
     from lsys_core.grammar import parse_grammar as _parse
 
-    return _parse(text)
+    return _parse(text, check_paths=True)
 
 
 def format_grammar(grammar: Any) -> str:

@@ -446,8 +446,9 @@ class Document(QObject):
             self._apply_text(out.text, grammar=out.result.grammar, drawing=out.drawing)
             self.undo_stack.setClean()
             self.pathChanged.emit()
-            for warning in getattr(out.scene, "warnings", ()):
-                self.message.emit(warning)
+            warnings = getattr(out.scene, "warnings", ())
+            if warnings:  # one line: the message bar shows only the latest message
+                self.message.emit("; ".join(warnings))
         elif purpose == "symmetrize":
             self.undo_stack.push(
                 TextCommand(

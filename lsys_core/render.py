@@ -5,21 +5,34 @@ skia path and paint per terminal, so repeated redraws (the editor's canvas)
 only pay for drawing.  :meth:`Renderer.draw` returns that array itself — no
 copy — which a Qt canvas can wrap in a ``QImage`` (``Format_RGBA8888_Premultiplied``).
 
-Full mode draws every instance with its own transform and anti-aliasing, in
-order.  Draft mode transforms each terminal's control points to all its
-instances with numpy and draws them as one path per terminal (and stroke-width
-bucket), without anti-aliasing and with thin strokes as hairlines: much faster,
-but overlaps between terminals no longer follow the instance order.
+Full mode (not draft) paints the instances in order, each instance's fill then its
+stroke, so overlaps are exact.  Most instances are drawn one by one, each with its own
+matrix.  Runs of consecutive instances whose painted rectangles (stroke outlines and
+joins included) pairwise neither overlap nor touch cover no pixel twice, so their
+order does not matter: where such a run is long and compact (:data:`FULL_MIN_RUN`,
+:data:`FULL_ROWS_PER_INSTANCE`), it is drawn as a few batched paths per terminal, at
+about twice the speed.  The picture is the same except that skia anti-aliases a big
+batched path by supersampling instead of analytically: edge pixels differ by a few
+levels (at most ~30 of 255), never the shapes, colours or order.
+
+Draft mode groups the instances by terminal and scale (quarter octaves), transforms
+each terminal's outline to all instances of a group with numpy, and draws them as a
+few big paths (:data:`DRAFT_CHUNK` instances each, built once and used for both
+the fill and the stroke), without anti-aliasing, with curves flattened into lines
+within :data:`DRAFT_TOLERANCE` pixels and with thin strokes as hairlines: much
+faster, but overlaps between different terminals or scale groups no longer follow
+the instance order (within a group, chunks are drawn in instance order).
 
 skia is imported inside the functions that use it.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import struct
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
@@ -34,6 +47,22 @@ __all__ = ["MAX_PNG_PIXELS", "Renderer", "encode_png", "fit_view", "parse_style"
 HIGHLIGHT = (255, 111, 0, 255)
 #: In draft mode, strokes thinner than this many pixels are drawn as hairlines.
 DRAFT_HAIRLINE = 2.0
+#: In draft mode, curves are replaced by lines at most this many pixels away from them.
+DRAFT_TOLERANCE = 0.5
+#: In draft mode, a curve needing more lines than this is left to skia's own subdivision.
+DRAFT_MAX_LINES = 8
+#: Instances per batched path (measured: skia fills ~1,000-instance paths without anti-aliasing
+#: about twice as fast per instance as one path of 10,000; building them stays a small part).
+DRAFT_CHUNK = 1024
+#: Full mode draws runs of at least this many consecutive instances whose painted rectangles
+#: are pairwise disjoint as batched anti-aliased paths (shorter runs are drawn one by one) ...
+FULL_MIN_RUN = 16
+#: ... when their centres lie within this many pixel rows per instance (measured on 10,000 leaves:
+#: runs spread over ~33 rows per instance draw 1.3x slower batched, compact ones 1.7x faster).
+FULL_ROWS_PER_INSTANCE = 4.0
+#: Full mode stops looking for such runs when boxes sharing a grid cell would give more than this
+#: many candidate pairs per instance (a dense scene, where runs would be short anyway).
+FULL_MAX_PAIRS = 8
 #: Most terminals (path, style) whose skia objects a renderer keeps.
 CACHE_SIZE = 4096
 #: Largest image side accepted, in pixels.
@@ -42,6 +71,7 @@ MAX_SIDE = 16384
 MAX_PNG_PIXELS = 40_000_000
 
 _VERB_MOVE, _VERB_LINE, _VERB_CUBIC, _VERB_CLOSE = 0, 1, 4, 5
+_BUCKETS_PER_OCTAVE = 4  # draft mode groups instances by scale in quarter octaves
 
 
 def parse_style(style: str) -> dict[str, str]:
@@ -149,11 +179,30 @@ def _skia_paint(rgba, antialias: bool, stroke: _Paints | None = None, width: flo
 
 @dataclass
 class _Geometry:
-    """A terminal's outline as skia path ingredients in its local frame."""
+    """A terminal's outline as skia path ingredients in its local frame.
+
+    ``points``/``verbs`` keep every curve; the per-segment arrays let :func:`_flatten`
+    replace curves by lines for a given scale.
+    """
 
     points: np.ndarray  # complex, (m,)
     verbs: np.ndarray  # uint8, (v,)
     radius: float  # max |p| of the control points (for culling)
+    cubics: np.ndarray  # complex, (k, 4): the segments
+    first: np.ndarray  # bool, (k,): segment starts a contour (a move precedes it)
+    closed: np.ndarray  # bool, (k,): a close follows the segment
+    is_line: np.ndarray  # bool, (k,): segment is straight
+    bend: np.ndarray  # float, (k,): max |second difference| of the control points
+
+
+_EMPTY = _Geometry(
+    np.zeros(0, complex),
+    np.zeros(0, np.uint8),
+    0.0,
+    np.zeros((0, 4), complex),
+    *(np.zeros(0, bool),) * 3,
+    np.zeros(0),
+)
 
 
 def _geometry(d: str) -> _Geometry:
@@ -163,12 +212,10 @@ def _geometry(d: str) -> _Geometry:
     try:
         cubics, subpaths, closed = cubics_from_d(d) if d.strip() else (np.zeros((0, 4), complex), None, ())
     except LsysError:
-        cubics, subpaths, closed = np.zeros((0, 4), complex), None, ()
+        return _EMPTY
     k = len(cubics)
-    if k == 0:
-        return _Geometry(np.zeros(0, complex), np.zeros(0, np.uint8), 0.0)
-    if not np.isfinite(cubics).all():
-        return _Geometry(np.zeros(0, complex), np.zeros(0, np.uint8), 0.0)
+    if k == 0 or not np.isfinite(cubics).all():
+        return _EMPTY
     scale = float(np.abs(cubics).max()) or 1.0
     is_line = _collinear_thirds(cubics, 1e-9 * scale)
     first = np.ones(k, dtype=bool)
@@ -187,7 +234,154 @@ def _geometry(d: str) -> _Geometry:
     v = np.where(is_line, _VERB_LINE, _VERB_CUBIC)
     parts = np.stack([np.where(first, _VERB_MOVE, -1), v, np.where(seg_closed, _VERB_CLOSE, -1)], axis=1)
     verbs = parts[parts >= 0].astype(np.uint8)
-    return _Geometry(points, verbs, float(np.abs(points).max()))
+    second = np.abs(cubics[:, :2] - 2 * cubics[:, 1:3] + cubics[:, 2:])
+    return _Geometry(
+        points, verbs, float(np.abs(points).max()), cubics, first, seg_closed, is_line, second.max(axis=1)
+    )
+
+
+def _flatten(geo: _Geometry, scale: float, tolerance: float) -> tuple[np.ndarray, np.ndarray]:
+    """Return points and verbs of ``geo`` with curves replaced by lines where few lines do.
+
+    A curve drawn at ``scale`` pixels per unit is split into ``n`` equal parameter steps, with
+    ``n`` from Wang's formula (chords within ``tolerance`` pixels of the curve); when ``n``
+    exceeds :data:`DRAFT_MAX_LINES` the curve is kept and skia subdivides it.
+    """
+    k = len(geo.cubics)
+    if k == 0:
+        return geo.points, geo.verbs
+    with np.errstate(invalid="ignore", over="ignore"):
+        need = np.sqrt(0.75 * geo.bend * (scale / tolerance))
+    n = np.where(geo.is_line, 1, np.ceil(np.nan_to_num(need, nan=np.inf, posinf=np.inf).clip(1, 1e6)))
+    curve = n > DRAFT_MAX_LINES  # kept as a cubic: 3 points, one verb
+    n = np.where(curve, 3, n).astype(np.intp)  # points of the segment after its optional move
+    first = geo.first.astype(np.intp)
+    # points
+    starts = np.concatenate([[0], np.cumsum(first + n)[:-1]])
+    body = starts + first
+    points = np.empty(int(starts[-1] + first[-1] + n[-1]), complex)
+    points[starts[geo.first]] = geo.cubics[geo.first, 0]
+    seg = np.repeat(np.arange(k), n)
+    step = np.arange(seg.size) - np.repeat(np.cumsum(n) - n, n)  # 0 .. n-1 within each segment
+    t = (step + 1) / n[seg]
+    c = geo.cubics[seg]
+    u = 1.0 - t
+    on_curve = u**3 * c[:, 0] + 3 * u * u * t * c[:, 1] + 3 * u * t * t * c[:, 2] + t**3 * c[:, 3]
+    control = c[np.arange(seg.size), np.minimum(step + 1, 3)]  # a kept cubic's c1, c2, end
+    points[body[seg] + step] = np.where(curve[seg], control, on_curve)
+    # verbs
+    lines = np.where(curve, 1, n)
+    closes = geo.closed.astype(np.intp)
+    vstarts = np.concatenate([[0], np.cumsum(first + lines + closes)[:-1]])
+    verbs = np.empty(int(vstarts[-1] + first[-1] + lines[-1] + closes[-1]), np.uint8)
+    verbs[vstarts[geo.first]] = _VERB_MOVE
+    vseg = np.repeat(np.arange(k), lines)
+    vstep = np.arange(vseg.size) - np.repeat(np.cumsum(lines) - lines, lines)
+    verbs[vstarts[vseg] + first[vseg] + vstep] = np.where(curve[vseg], _VERB_CUBIC, _VERB_LINE)
+    verbs[(vstarts + first + lines)[geo.closed]] = _VERB_CLOSE
+    return points, verbs
+
+
+def _groups(symbol: np.ndarray, bucket: np.ndarray) -> list[np.ndarray]:
+    """Split positions into groups of equal ``(symbol, bucket)``, each in increasing order."""
+    if symbol.size == 0:
+        return []
+    s0, b0 = symbol.min(), bucket.min()
+    key = (symbol - s0) * (int(bucket.max() - b0) + 1) + (bucket - b0)
+    if key.max() == key.min():
+        return [np.arange(symbol.size)]
+    if key.max() < np.iinfo(np.int16).max:
+        key = key.astype(np.int16)  # a stable sort of small integers is a radix sort
+    order = np.argsort(key, kind="stable")
+    cuts = np.flatnonzero(np.diff(key[order])) + 1
+    return np.split(order, cuts)
+
+
+def _rectangles_overlap(d: np.ndarray, u1, w1, h1, u2, w2, h2) -> np.ndarray:
+    """Return whether rectangles overlap or touch (separating axis test along their four sides).
+
+    Rectangle ``k`` has half sides ``w_k`` along the unit direction ``u_k`` and ``h_k`` across it;
+    their centres are ``d`` apart (complex numbers as points and directions).
+    """
+    rel = u2 * u1.conjugate()
+    c, s = np.abs(rel.real), np.abs(rel.imag)
+    d1 = d * u1.conjugate()  # d in the frame of rectangle 1
+    d2 = d * u2.conjugate()
+    return (
+        (np.abs(d1.real) <= w1 + w2 * c + h2 * s)
+        & (np.abs(d1.imag) <= h1 + w2 * s + h2 * c)
+        & (np.abs(d2.real) <= w2 + w1 * c + h1 * s)
+        & (np.abs(d2.imag) <= h2 + w1 * s + h1 * c)
+    )
+
+
+def _disjoint_runs(
+    center: np.ndarray, u: np.ndarray, w: np.ndarray, h: np.ndarray, min_length: int
+) -> list[tuple[int, int]]:
+    """Return ``(start, stop)`` of the runs of consecutive rectangles that pairwise do not overlap.
+
+    Rectangle ``k`` is centred on ``center[k]`` with half sides ``w[k]`` along the unit direction
+    ``u[k]`` and ``h[k]`` across it (complex numbers as points and directions).  Rectangles are
+    cut greedily into maximal runs, in order: a run ends before the first rectangle that overlaps
+    (or touches) an earlier one of the run; only runs of at least ``min_length`` are returned.
+    Pairs to test are found through a grid of cells as large as a typical axis-aligned bound, so
+    the work stays linear; a rectangle spanning more than three cells a side counts as overlapping
+    its neighbours in the order, and a scene whose bounds crowd the cells (more than
+    :data:`FULL_MAX_PAIRS` candidate pairs per rectangle) has no runs.
+    """
+    n = center.size
+    if n < max(min_length, 2):
+        return [(0, n)] if 0 < n >= min_length else []
+    ex = w * np.abs(u.real) + h * np.abs(u.imag)
+    ey = w * np.abs(u.imag) + h * np.abs(u.real)
+    x0, x1 = center.real - ex, center.real + ex
+    y0, y1 = center.imag - ey, center.imag + ey
+    cell = max(2 * float(np.median(ex)), 2 * float(np.median(ey)), 0.25)  # pixels
+    if not math.isfinite(cell):
+        return []
+    gx0, gy0 = np.floor(x0 / cell), np.floor(y0 / cell)
+    gx1, gy1 = np.floor(x1 / cell), np.floor(y1 / cell)
+    small = (gx1 - gx0 <= 2) & (gy1 - gy0 <= 2)
+    if not small.any():
+        return []
+    ox, oy = gx0[small].min(), gy0[small].min()
+    cols = int(gy1[small].max() - oy) + 1
+    if (gx1[small].max() - ox + 3) * (cols + 3) * n >= 2.0**62:  # cell keys would overflow
+        return []
+    # (cell, rectangle) entries of the small ones, up to 3 x 3 cells each, sorted by cell then rectangle
+    keys = []
+    for dx in range(3):
+        for dy in range(3):
+            m = np.flatnonzero(small & (gx0 + dx <= gx1) & (gy0 + dy <= gy1))
+            keys.append(((gx0[m] + dx - ox) * cols + (gy0[m] + dy - oy)).astype(np.int64) * n + m)
+    cell_of, box = np.divmod(np.sort(np.concatenate(keys)), n)
+    # candidate pairs: every two rectangles sharing a cell
+    starts = np.flatnonzero(np.r_[True, cell_of[1:] != cell_of[:-1]])
+    sizes = np.diff(np.r_[starts, cell_of.size])
+    if int((sizes * (sizes - 1) // 2).sum()) > FULL_MAX_PAIRS * n:
+        return []
+    later = np.repeat(starts + sizes, sizes) - np.arange(cell_of.size) - 1  # entries after each
+    first = np.repeat(np.arange(cell_of.size), later)
+    second = first + 1 + np.arange(first.size) - np.repeat(np.cumsum(later) - later, later)
+    i, j = box[first], box[second]  # i < j
+    hit = (x0[i] <= x1[j]) & (x0[j] <= x1[i]) & (y0[i] <= y1[j]) & (y0[j] <= y1[i])
+    i, j = i[hit], j[hit]
+    hit = _rectangles_overlap(center[j] - center[i], u[i], w[i], h[i], u[j], w[j], h[j])
+    big = np.flatnonzero(~small)
+    i = np.concatenate([i[hit], big - 1, big])  # a big rectangle runs alone
+    j = np.concatenate([j[hit], big, big + 1])
+    keep = (i >= 0) & (j < n)
+    # A run starting at s ends at the first j overlapping some i >= s of the run.
+    stop = np.full(n + 1, n, dtype=np.int64)
+    np.minimum.at(stop, i[keep], j[keep])
+    stop = np.minimum.accumulate(stop[::-1])[::-1].tolist()
+    runs, s = [], 0
+    while s < n:
+        e = stop[s]
+        if e - s >= min_length:
+            runs.append((s, e))
+        s = e
+    return runs
 
 
 @lru_cache(maxsize=1)
@@ -222,15 +416,20 @@ def _serialize(points_xy: np.ndarray, verbs: np.ndarray, evenodd: bool) -> bytes
 
 def _path_from_arrays(points: np.ndarray, verbs: np.ndarray, evenodd: bool):
     """Build a skia path from complex ``points`` and skia ``verbs`` (bulk when possible)."""
+    xy = np.stack([points.real, points.imag], axis=-1).reshape(-1, 2)
+    return _path_from_xy(xy, verbs, evenodd)
+
+
+def _path_from_xy(xy: np.ndarray, verbs: np.ndarray, evenodd: bool):
+    """Build a skia path from ``(m, 2)`` point coordinates and skia ``verbs`` (bulk when possible)."""
     import skia
 
-    xy = np.stack([points.real, points.imag], axis=-1).reshape(-1, 2)
     if _serialization_works():
         path = skia.Path()
         if path.readFromMemory(_serialize(xy, verbs, evenodd)):
             return path
     fill = skia.PathFillType.kEvenOdd if evenodd else skia.PathFillType.kWinding
-    pts = [skia.Point(float(x), float(y)) for x, y in xy.tolist()]
+    pts = [skia.Point(float(x), float(y)) for x, y in np.asarray(xy, dtype=np.float64).tolist()]
     return skia.Path.Make(pts, verbs.tolist(), [], fill)
 
 
@@ -267,6 +466,18 @@ def default_view(drawing: Drawing) -> tuple[float, float, float, float]:
 # The renderer
 
 
+def _painted_box(path, stroke) -> tuple[float, float, float, float]:
+    """Return the tight bounds ``x0, y0, x1, y1`` of a path's fill and ``stroke`` (joins included)."""
+    import skia
+
+    box = path.computeTightBounds()
+    if stroke is not None:
+        outline = skia.Path()
+        if stroke.getFillPath(path, outline):
+            box.join(outline.computeTightBounds())
+    return box.left(), box.top(), box.right(), box.bottom()
+
+
 @dataclass
 class _Terminal:
     geometry: _Geometry
@@ -274,6 +485,23 @@ class _Terminal:
     path: object  # skia.Path in the local frame
     fill_aa: object | None
     fill_noaa: object | None
+    stroke_aa: object | None  # at the style's width, in the local frame (full mode)
+    stroke_noaa: object | None
+    box: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)  # x0, y0, x1, y1 of what it paints
+    flat: dict[int, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)  # draft outline by bucket
+
+    def ops(self, antialias: bool, *, fill: bool = True) -> tuple[tuple[object, object], ...]:
+        """Return the ``(path, paint)`` draws of one instance in full mode: fill (if ``fill``), stroke."""
+        paints = (self.fill_aa, self.stroke_aa) if antialias else (self.fill_noaa, self.stroke_noaa)
+        return tuple((self.path, p) for p in paints[0 if fill else 1 :] if p is not None)
+
+    def flattened(self, bucket: int) -> tuple[np.ndarray, np.ndarray]:
+        """Return the draft outline (points, verbs) for instances of scale bucket ``bucket``."""
+        entry = self.flat.get(bucket)
+        if entry is None:
+            top = 2.0 ** ((bucket + 0.5) / _BUCKETS_PER_OCTAVE)  # the largest scale of the bucket
+            entry = self.flat[bucket] = _flatten(self.geometry, top, DRAFT_TOLERANCE)
+        return entry
 
 
 class Renderer:
@@ -327,10 +555,12 @@ class Renderer:
             geometry = _geometry(path)
             paints = _paints(style)
             skpath = _path_from_arrays(geometry.points, geometry.verbs, paints.evenodd)
-            fills = (None, None)
+            fills = strokes = (None, None)
             if paints.fill is not None:
                 fills = (_skia_paint(paints.fill, True), _skia_paint(paints.fill, False))
-            entry = _Terminal(geometry, paints, skpath, *fills)
+            if paints.stroke is not None:
+                strokes = tuple(_skia_paint(paints.stroke, aa, paints, paints.width) for aa in (True, False))
+            entry = _Terminal(geometry, paints, skpath, *fills, *strokes, _painted_box(skpath, strokes[0]))
             self._cache[key] = entry
         return entry
 
@@ -355,7 +585,9 @@ class Renderer:
         antialias : bool
             Anti-alias edges (ignored in draft mode, which never does).
         draft : bool
-            Batch each terminal's instances into one path (fast, approximate order).
+            Draw a draft: instances batched by terminal and scale into a few paths, curves
+            flattened (fast; overlaps of different terminals in approximate order).  Full mode
+            keeps the exact order (see the module notes).
         background : (r, g, b, a)
             Colour the image is cleared to.
         highlight : ndarray of int or bool, optional
@@ -417,59 +649,62 @@ class Renderer:
         return ok & ~empty[sym] & np.isfinite(rr) & np.isfinite(db)
 
     def _draw_each(self, terms, symbol, da, db, visible, antialias: bool) -> None:
-        """Draw every visible instance with its own matrix, in order."""
-        import skia
+        """Draw the visible instances in order: one by one, or in batches where that is the same.
 
-        canvas = self._canvas
+        Runs of at least :data:`FULL_MIN_RUN` consecutive instances whose painted rectangles
+        are pairwise disjoint cover no pixel twice (except anti-aliased edge pixels of touching
+        instances), so drawing them terminal by terminal as batched paths gives the same picture
+        (such shared edge pixels blend as in one shape, without a seam); the rest is drawn one
+        by one, each instance with its own matrix.
+        """
         idx = np.flatnonzero(visible)
         if idx.size == 0:
             return
-        mats = np.stack([da.real, -da.imag, db.real, da.imag, da.real, db.imag], axis=1)[idx]
-        matrix = skia.Matrix()
-        stroke_cache: dict[tuple[int, float], object] = {}
-        for t, m in zip(symbol[idx].tolist(), mats.tolist(), strict=True):
-            term = terms[t]
-            matrix.setAll(m[0], m[1], m[2], m[3], m[4], m[5], 0.0, 0.0, 1.0)
-            canvas.setMatrix(matrix)
-            if term.fill_aa is not None:
-                canvas.drawPath(term.path, term.fill_aa if antialias else term.fill_noaa)
-            if term.paints.stroke is not None:
-                key = (t, antialias)
-                paint = stroke_cache.get(key)
-                if paint is None:
-                    paint = _skia_paint(term.paints.stroke, antialias, term.paints, term.paints.width)
-                    stroke_cache[key] = paint
-                canvas.drawPath(term.path, paint)
+        full = _FullPass(self._canvas, terms, symbol[idx], da[idx], db[idx], antialias)
+        done = 0
+        for lo, hi in full.compact_runs():
+            full.one_by_one(range(done, lo))
+            full.run(lo, hi)
+            done = hi
+        full.one_by_one(range(done, idx.size))
 
     def _draw_batched(self, terms, symbol, da, db, visible) -> None:
-        """Draft: one path per terminal (and stroke-width bucket) with all its instances."""
+        """Draft: per terminal and scale bucket, chunks of instances drawn as one path each."""
         canvas = self._canvas
         canvas.resetMatrix()
-        for t, term in enumerate(terms):
-            sel = np.flatnonzero(visible & (symbol == t))
-            if sel.size == 0:
-                continue
-            geo, paints = term.geometry, term.paints
-            if paints.fill is not None:
-                path = self._batch_path(geo, da[sel], db[sel], paints.evenodd)
-                canvas.drawPath(path, term.fill_noaa)
+        idx = np.flatnonzero(visible)
+        if idx.size == 0:
+            return
+        scale = np.abs(da[idx])
+        bucket = np.round(np.log2(np.maximum(scale, 1e-30)) * _BUCKETS_PER_OCTAVE).astype(np.int64)
+        sym = symbol[idx]
+        for group in _groups(sym, bucket):
+            t, key = int(sym[group[0]]), int(bucket[group[0]])
+            term = terms[t]
+            paints = term.paints
+            points, verbs = term.flattened(key)
+            stroke = None
             if paints.stroke is not None:
-                # Group instances by scale so stroke widths stay close to the true ones.
-                scale = np.abs(da[sel])
-                bucket = np.round(np.log2(np.maximum(scale, 1e-30)) * 4).astype(np.int64)
-                for key in np.unique(bucket).tolist():
-                    part = sel[bucket == key]
-                    width = paints.width * float(np.median(np.abs(da[part])))
-                    if width < DRAFT_HAIRLINE:
-                        width = 0.0  # a hairline: far cheaper than stroking thin outlines
-                    path = self._batch_path(geo, da[part], db[part], False)
-                    canvas.drawPath(path, _skia_paint(paints.stroke, False, paints, width))
+                # One width per bucket: within a quarter octave of every instance's true width.
+                width = paints.width * float(np.median(scale[group]))
+                if width < DRAFT_HAIRLINE:
+                    width = 0.0  # a hairline: far cheaper than stroking thin outlines
+                stroke = _skia_paint(paints.stroke, False, paints, width)
+            inst = idx[group]
+            for lo in range(0, inst.size, DRAFT_CHUNK):
+                part = inst[lo : lo + DRAFT_CHUNK]
+                path = self._batch_path(points, verbs, da[part], db[part], paints.evenodd)
+                if term.fill_noaa is not None:
+                    canvas.drawPath(path, term.fill_noaa)
+                if stroke is not None:
+                    canvas.drawPath(path, stroke)
 
     @staticmethod
-    def _batch_path(geo: _Geometry, a: np.ndarray, b: np.ndarray, evenodd: bool):
-        pts = (a[:, None] * geo.points[None, :] + b[:, None]).reshape(-1)
-        verbs = np.tile(geo.verbs, a.size)
-        return _path_from_arrays(pts, verbs, evenodd)
+    def _batch_path(points: np.ndarray, verbs: np.ndarray, a: np.ndarray, b: np.ndarray, evenodd: bool):
+        """Return one path of the outline ``points``/``verbs`` placed at every pose ``z -> a z + b``."""
+        pts = a[:, None] * points[None, :] + b[:, None]  # complex (instances, points)
+        xy = pts.view(np.float64).astype(np.float32).reshape(-1, 2)
+        return _path_from_xy(xy, np.tile(verbs, a.size), evenodd)
 
     def _draw_highlight(self, terms, symbol, da, db, mask, antialias: bool) -> None:
         """Draw the selected instances on top in the highlight colour."""
@@ -480,13 +715,134 @@ class Renderer:
             sel = np.flatnonzero(mask & (symbol == t))
             if sel.size == 0:
                 continue
-            path = self._batch_path(term.geometry, da[sel], db[sel], term.paints.evenodd)
+            geo = term.geometry
+            path = self._batch_path(geo.points, geo.verbs, da[sel], db[sel], term.paints.evenodd)
             if term.paints.fill is not None:
                 canvas.drawPath(path, _skia_paint((r, g, b, a // 2), antialias))
             outline = _skia_paint(
                 (r, g, b, a), antialias, _Paints(None, None, 1.5, "round", "round", 4.0, False), 1.5
             )
             canvas.drawPath(path, outline)
+
+
+class _FullPass:
+    """One full-mode drawing of instances (already culled) into a canvas, in their order."""
+
+    def __init__(self, canvas, terms: list[_Terminal], symbol, a, b, antialias: bool) -> None:
+        self.canvas, self.terms, self.antialias = canvas, terms, antialias
+        self.symbol, self.a, self.b = symbol, a, b
+        mats = np.zeros((a.size, 9))
+        mats[:, 0] = mats[:, 4] = a.real
+        mats[:, 1] = -a.imag
+        mats[:, 3] = a.imag
+        mats[:, 2] = b.real
+        mats[:, 5] = b.imag
+        mats[:, 8] = 1.0
+        self.mats = mats.tolist()
+        self.symbols = symbol.tolist()
+        self.ops = [t.ops(antialias) for t in terms]
+        self.stroke_ops = [t.ops(antialias, fill=False) for t in terms]
+        self._same_scale: np.ndarray | None = None
+
+    def boxes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Return the device rectangles the instances paint, strokes included (see :func:`_disjoint_runs`)."""
+        local = np.zeros((len(self.terms), 3), dtype=complex)
+        for k, t in enumerate(self.terms):
+            x0, y0, x1, y1 = t.box
+            local[k] = (complex(x0 + x1, y0 + y1) / 2, (x1 - x0) / 2, (y1 - y0) / 2)
+        c, w, h = local[self.symbol].T
+        scale = np.abs(self.a)
+        u = np.where(scale > 0, self.a / np.where(scale > 0, scale, 1.0), 1.0)
+        return self.a * c + self.b, u, w.real * scale, h.real * scale
+
+    def compact_runs(self) -> list[tuple[int, int]]:
+        """Return the runs worth batching: disjoint instances within few pixel rows per instance.
+
+        Batched paths spread over many rows fill slower than their instances one by one, so
+        scenes too small to gain, or whose consecutive instances are far apart vertically
+        (median step over twice :data:`FULL_ROWS_PER_INSTANCE` rows) are not searched at all.
+        """
+        y = self.b.imag
+        if y.size < 8 * FULL_MIN_RUN or np.median(np.abs(np.diff(y))) > 2 * FULL_ROWS_PER_INSTANCE:
+            return []
+        boxes = self.boxes()
+        y = boxes[0].imag
+        runs = _disjoint_runs(*boxes, FULL_MIN_RUN)
+        return [(lo, hi) for lo, hi in runs if np.ptp(y[lo:hi]) <= FULL_ROWS_PER_INSTANCE * (hi - lo)]
+
+    def one_by_one(self, positions, *, strokes_only: bool = False) -> None:
+        """Draw the instances at ``positions`` in that order, each with its own matrix."""
+        import skia
+
+        table = self.stroke_ops if strokes_only else self.ops
+        mats, symbols = self.mats, self.symbols
+        matrix = skia.Matrix()
+        set_all, set_matrix, draw_path = matrix.setAll, self.canvas.setMatrix, self.canvas.drawPath
+        for k in positions:
+            set_all(*mats[k])
+            set_matrix(matrix)
+            for path, paint in table[symbols[k]]:
+                draw_path(path, paint)
+        self.canvas.resetMatrix()
+
+    def run(self, lo: int, hi: int) -> None:
+        """Draw instances ``lo:hi``, which cover no pixel twice, in any order: batched where possible.
+
+        Per terminal, the fills go into batched paths; a stroke joins them when the instances
+        share one scale (stroke widths scale with the instance), else strokes of equal scale
+        are batched and the others drawn one by one, as are terminals used fewer than four times.
+        """
+        if self._same_scale is None:  # scales equal within 1e-6 share a key
+            self._same_scale = np.round(np.log2(np.maximum(np.abs(self.a), 1e-300)) * 2**20).astype(np.int64)
+        sym, same = self.symbol[lo:hi], self._same_scale[lo:hi]
+        order = np.lexsort((same, sym)) + lo
+        sym, same = self.symbol[order], self._same_scale[order]
+        change = sym[1:] != sym[:-1]
+        terminal_starts = [0, *(np.flatnonzero(change) + 1).tolist(), order.size]
+        scale_starts = np.flatnonzero(np.r_[True, change | (same[1:] != same[:-1]), True]).tolist()
+        loose, strokes = [], []  # drawn one by one: whole instances, strokes only
+        k = 0
+        for t0, t1 in itertools.pairwise(terminal_starts):
+            parts = []
+            while scale_starts[k] < t1:
+                parts.append((scale_starts[k], scale_starts[k + 1]))
+                k += 1
+            if t1 - t0 < 4:
+                loose.append(order[t0:t1])
+                continue
+            term = self.terms[int(sym[t0])]
+            fill = term.fill_aa if self.antialias else term.fill_noaa
+            if term.paints.stroke is None:
+                self.batch(term, order[t0:t1], fill, None)
+                continue
+            if len(parts) > 1 and fill is not None:
+                self.batch(term, order[t0:t1], fill, None)
+                fill = None
+            for s0, s1 in parts:
+                if s1 - s0 < 4:
+                    strokes.append(order[s0:s1])
+                    continue
+                paints = term.paints
+                width = paints.width * abs(self.a[order[s0]])
+                self.batch(
+                    term, order[s0:s1], fill, _skia_paint(paints.stroke, self.antialias, paints, width)
+                )
+        if loose:
+            self.one_by_one(np.concatenate(loose).tolist())
+        if strokes:
+            self.one_by_one(np.concatenate(strokes).tolist(), strokes_only=True)
+
+    def batch(self, term: _Terminal, positions: np.ndarray, fill, stroke) -> None:
+        """Draw the terminal at ``positions`` as batched device-space paths with the given paints."""
+        geo = term.geometry
+        for lo in range(0, positions.size, DRAFT_CHUNK):
+            part = positions[lo : lo + DRAFT_CHUNK]
+            path = Renderer._batch_path(
+                geo.points, geo.verbs, self.a[part], self.b[part], term.paints.evenodd
+            )
+            for paint in (fill, stroke):
+                if paint is not None:
+                    self.canvas.drawPath(path, paint)
 
 
 def _unpremultiply(pixels: np.ndarray) -> np.ndarray:

@@ -8,7 +8,9 @@ Reports, in milliseconds:
   (draft frames; target ≤ 16 ms for 10,000 and ≤ 250 ms for 100,000) and after the release
   (full anti-aliased quality; target ≤ 100 ms for 10,000).  Each move is timed from
   ``QSlider.setValue`` on the UI thread to the end of a synchronous ``repaint()`` that shows
-  the frame of the new value.
+  the frame of the new value.  The drag bends every row into overlapping coils, so the
+  released frame is drawn instance by instance (``lsys_core.render`` batches full-quality
+  frames only where instances do not overlap: see ``bench_render.py``'s "rows" scene).
 * the longest UI-thread stall while inference of a 1,200-element scene runs in the background,
   with inference in a worker thread and in a worker process: a 2 ms QTimer on the UI thread
   records the gaps between its ticks (a stall is a gap minus the 2 ms period).
@@ -101,7 +103,11 @@ def bench_slider(app, workdir: Path, rows: int, cols: int, moves: int) -> dict:
     """Time slider moves while dragging (drafts) and the full-quality frame after release."""
     path = workdir / f"grid-{rows}x{cols}.lsys"
     path.write_text(grid_grammar(rows, cols), encoding="utf-8")
-    win = make_window()
+    from app.jobs import run_inference
+
+    # No inference here: without a worker process, no process start-up (imports) competes with
+    # the timed frames for the two cores.
+    win = make_window(infer_compute=run_inference)
     win.open_path(str(path))
     wait_until(app, win.is_idle)
     n = len(win.doc.drawing)

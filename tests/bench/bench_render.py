@@ -1,5 +1,8 @@
 """Print the time to render 10,000 and 100,000 small leaf-like paths at 1600×1200 (not a test).
 
+Two scenes: leaves and stems scattered at random (overlapping, random scales: full mode draws
+them one by one) and leaves in rows, side by side without overlapping (full mode batches them).
+
 Run: ``PYTHONPATH=. .venv/bin/python tests/bench/bench_render.py``
 """
 
@@ -35,6 +38,23 @@ def make_drawing(n: int, seed: int = 0) -> Drawing:
     )
 
 
+def make_rows(n: int) -> Drawing:
+    """Return ``n`` leaves in rows across the canvas, each turned a little, none overlapping."""
+    cols = round(np.sqrt(n * WIDTH / HEIGHT))
+    step = WIDTH / cols
+    k = np.arange(n)
+    a = (step / 26.0) * np.exp(1j * np.radians(0.1 * (k % cols)))
+    b = (k % cols) * step + 1j * (k // cols) * step * 0.6
+    return Drawing(
+        terminals=(LEAF,),
+        symbol=np.zeros(n, np.int32),
+        a=a,
+        b=b,
+        rule=np.zeros(n, np.int32),
+        viewbox=(0.0, -step, float(WIDTH), float(b.imag.max() + 2 * step)),
+    )
+
+
 def median_time(fn, runs: int) -> float:
     """Return the median wall time of ``runs`` calls of ``fn``."""
     times = []
@@ -48,15 +68,18 @@ def median_time(fn, runs: int) -> float:
 def main() -> None:
     """Print render times in full and draft mode."""
     renderer = Renderer(WIDTH, HEIGHT)
-    for n in (10_000, 100_000):
-        drawing = make_drawing(n)
-        renderer.draw(drawing)  # warm the terminal cache
-        runs = 5 if n <= 10_000 else 3
-        full = median_time(lambda d=drawing: renderer.draw(d, antialias=True), runs)
-        draft = median_time(lambda d=drawing: renderer.draw(d, draft=True), runs)
-        print(
-            f"{n:>7} instances at {WIDTH}x{HEIGHT}: full {full * 1000:8.1f} ms   draft {draft * 1000:8.1f} ms"
-        )
+    for scene, make in (("scattered", make_drawing), ("rows", make_rows)):
+        for n in (10_000, 100_000):
+            drawing = make(n)
+            renderer.draw(drawing)  # warm the terminal cache
+            runs = 5 if n <= 10_000 else 3
+            full = median_time(lambda d=drawing: renderer.draw(d, antialias=True), runs)
+            draft = median_time(lambda d=drawing: renderer.draw(d, draft=True), runs)
+            print(
+                f"{scene:>9} {n:>7} instances at {WIDTH}x{HEIGHT}: "
+                f"full {full * 1000:8.1f} ms   draft {draft * 1000:8.1f} ms",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":
