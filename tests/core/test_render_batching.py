@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lsys_core import render
+from lsys_core import render, render_paths
 from lsys_core.grammar.model import Terminal
 from lsys_core.model import Drawing
 from lsys_core.render import Renderer
@@ -47,25 +47,30 @@ def one_by_one(monkeypatch, renderer: Renderer, drawing: Drawing) -> np.ndarray:
 
 @pytest.mark.parametrize("scale", [0.2, 1.0, 4.0, 40.0])
 def test_flattened_outline_stays_within_tolerance(scale):
-    geo = render._geometry(LEAF + " M 30 0 L 40 0 L 40 5 Z")
-    points, verbs = render._flatten(geo, scale, 0.5)
-    counts = {render._VERB_MOVE: 1, render._VERB_LINE: 1, render._VERB_CUBIC: 3, render._VERB_CLOSE: 0}
+    geo = render_paths._geometry(LEAF + " M 30 0 L 40 0 L 40 5 Z")
+    points, verbs = render_paths._flatten(geo, scale, 0.5)
+    counts = {
+        render_paths._VERB_MOVE: 1,
+        render_paths._VERB_LINE: 1,
+        render_paths._VERB_CUBIC: 3,
+        render_paths._VERB_CLOSE: 0,
+    }
     assert sum(counts[v] for v in verbs.tolist()) == len(points)
-    assert (verbs == render._VERB_MOVE).sum() == 2 and (verbs == render._VERB_CLOSE).sum() == 2
-    if (verbs == render._VERB_CUBIC).any():  # too many lines would be needed: skia subdivides
+    assert (verbs == render_paths._VERB_MOVE).sum() == 2 and (verbs == render_paths._VERB_CLOSE).sum() == 2
+    if (verbs == render_paths._VERB_CUBIC).any():  # too many lines would be needed: skia subdivides
         assert scale >= 40
         return
     # every point of the true curves lies within 0.5 px of the polyline
     t = np.linspace(0, 1, 400)[:, None]
     p0, p1, p2, p3 = geo.cubics[:2].T
     curve = ((1 - t) ** 3 * p0 + 3 * (1 - t) ** 2 * t * p1 + 3 * (1 - t) * t**2 * p2 + t**3 * p3).ravel()
-    first_close = int(np.flatnonzero(verbs == render._VERB_CLOSE)[0])
+    first_close = int(np.flatnonzero(verbs == render_paths._VERB_CLOSE)[0])
     ring = points[: sum(counts[v] for v in verbs[:first_close].tolist())]  # the leaf's contour
     p, q = ring, np.roll(ring, -1)
     u = np.clip(((curve[:, None] - p) * np.conj(q - p)).real / np.maximum(np.abs(q - p) ** 2, 1e-30), 0, 1)
     distance = np.abs(curve[:, None] - (p + u * (q - p))).min(axis=1) * scale
     assert distance.max() <= 0.5
-    assert len(ring) <= 1 + 2 * render.DRAFT_MAX_LINES
+    assert len(ring) <= 1 + 2 * render_paths.DRAFT_MAX_LINES
 
 
 def test_draft_draws_every_chunk_with_fill_and_stroke():
@@ -114,12 +119,12 @@ def test_disjoint_runs_match_pairwise_tests(seed):
     u = np.exp(1j * rng.uniform(0, 2 * np.pi, n))
     w, h = np.full(n, 6.0), np.full(n, 2.0)
     rects = (c, u, w, h)
-    runs = render._disjoint_runs(*rects, 1)
+    runs = render_paths._disjoint_runs(*rects, 1)
     if spread == 400:  # crowded scenes may give up: no runs, all drawn one by one
         assert len(runs) > 1
     if runs:
         assert runs == brute_runs(rects, 1)
-        assert render._disjoint_runs(*rects, 4) == [(s, e) for s, e in runs if e - s >= 4]
+        assert render_paths._disjoint_runs(*rects, 4) == [(s, e) for s, e in runs if e - s >= 4]
 
 
 def test_rectangles_overlap_is_exact_for_turned_rectangles():
@@ -127,14 +132,14 @@ def test_rectangles_overlap_is_exact_for_turned_rectangles():
     one = np.array([1.0])
     # a diamond of half side 1 beside a unit square: corners 1 + sqrt(2) apart along x
     gap = np.array([1 + np.sqrt(2) + 0.01 + 0j])
-    assert not render._rectangles_overlap(gap, u1, one, one, u2, one, one)[0]
-    assert render._rectangles_overlap(gap - 0.02, u1, one, one, u2, one, one)[0]
+    assert not render_paths._rectangles_overlap(gap, u1, one, one, u2, one, one)[0]
+    assert render_paths._rectangles_overlap(gap - 0.02, u1, one, one, u2, one, one)[0]
     # axis-aligned bounds overlap, rectangles do not (thin diagonal bars side by side)
     bars = np.array([np.exp(1j * np.pi / 4)])
     apart = np.array([1.5j * np.exp(1j * np.pi / 4)])
-    assert not render._rectangles_overlap(apart, bars, np.array([5.0]), one * 0.5, bars, one * 5, one * 0.5)[
-        0
-    ]
+    assert not render_paths._rectangles_overlap(
+        apart, bars, np.array([5.0]), one * 0.5, bars, one * 5, one * 0.5
+    )[0]
 
 
 def test_full_mode_batches_disjoint_grid_with_the_same_picture(monkeypatch):
