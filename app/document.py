@@ -32,7 +32,7 @@ from .workers import LatestRunner, ProcessCompute
 __all__ = ["Document"]
 
 PARSE_DELAY_MS = 150
-INFER_DELAY_MS = 250
+INFER_DELAY_MS = 80
 #: Modules the inference process imports as it starts (while the window opens).
 INFER_PRELOAD = ("lsys_core.pipeline", "lsys_core.similarity", "lsys_core.svg.parse", "lsys_core.grammar")
 
