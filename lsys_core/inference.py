@@ -243,12 +243,9 @@ def build_hierarchy(
     dup = _duplicates(bld, sym, a, b)
     if dup:
         level += 1
-        for k, cand in enumerate(dup):
-            sym, a, b, center, radius, members, mapping = _apply(
-                bld, cand, sym, a, b, center, radius, members, node_rule
-            )
-            for later in dup[k + 1 :]:
-                _remap(later, mapping)
+        sym, a, b, center, radius, members = _apply_all(
+            bld, dup, sym, a, b, center, radius, members, node_rule
+        )
     while a.size > 1:
         check(cancel)
         report(progress, "rules", 1.0 - (a.size - 1) / max(n0 - 1, 1))
@@ -267,12 +264,9 @@ def build_hierarchy(
             else:
                 chosen = _batch(best, cands, a.size)
                 level += 1
-                for k, cand in enumerate(chosen):
-                    sym, a, b, center, radius, members, mapping = _apply(
-                        bld, cand, sym, a, b, center, radius, members, node_rule
-                    )
-                    for later in chosen[k + 1 :]:
-                        _remap(later, mapping)
+                sym, a, b, center, radius, members = _apply_all(
+                    bld, chosen, sym, a, b, center, radius, members, node_rule
+                )
         else:
             cands = []
         clock["transforms"] += t1 - t0
@@ -360,6 +354,17 @@ def _nodes_of(c: Candidate) -> np.ndarray:
     if c.kind == "branch":
         return np.concatenate([t[2] for t in c.groups])
     return np.concatenate([np.asarray(g) for g in c.groups])
+
+
+def _apply_all(bld: _Builder, chosen: list[Candidate], sym, a, b, center, radius, members, node_rule):
+    """Apply candidates on disjoint nodes one after another, renumbering the later ones' nodes."""
+    for k, cand in enumerate(chosen):
+        sym, a, b, center, radius, members, mapping = _apply(
+            bld, cand, sym, a, b, center, radius, members, node_rule
+        )
+        for later in chosen[k + 1 :]:
+            _remap(later, mapping)
+    return sym, a, b, center, radius, members
 
 
 def _remap(c: Candidate, mapping: np.ndarray) -> None:
