@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import LimitError, SvgError
 from ..model import Element, Scene
-from .pathdata import RawPath, assemble, raw_from_d, raw_from_segments
+from .pathdata import SVGELEMENTS_ERRORS, RawPath, assemble, raw_from_d, raw_from_segments
 
 __all__ = ["DEFAULT_MAX_BYTES", "DEFAULT_MAX_DEPTH", "DEFAULT_MAX_ELEMENTS", "load_svg", "parse_svg"]
 
@@ -72,16 +72,6 @@ _LENGTH = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(?:px|pt
 #: An opacity declaration in a ``style`` attribute or a style sheet.
 _OPACITY_DECL = re.compile(r"(?i)((?<![\w-])(?:fill-|stroke-)?opacity\s*:\s*)([^;}!\s]+)")
 _OPACITY_ATTRS = ("opacity", "fill-opacity", "stroke-opacity")
-#: Exceptions svgelements raises on values it cannot handle.
-_SVGELEMENTS_ERRORS = (
-    ValueError,
-    TypeError,
-    IndexError,
-    KeyError,
-    AttributeError,
-    ZeroDivisionError,
-    OverflowError,
-)
 
 
 @dataclass
@@ -363,11 +353,11 @@ def _path_raw(d: str | None) -> tuple[RawPath, str | None]:
 
     try:
         path = Path(d)
-    except (*_SVGELEMENTS_ERRORS, RecursionError):
+    except (*SVGELEMENTS_ERRORS, RecursionError):
         return RawPath([], [], [], []), "malformed path data"
     try:
         raw = raw_from_segments(path)
-    except _SVGELEMENTS_ERRORS:
+    except SVGELEMENTS_ERRORS:
         return RawPath([], [], [], []), "invalid geometry"
     has_arc = "a" in d or "A" in d
     return raw, (None if has_arc else "malformed path data")
@@ -548,7 +538,7 @@ def _extract(prepared: _Prepared, name: str) -> tuple[list[Element], _Skips]:
         vbt = doc.viewbox_transform if isinstance(doc, SVG) else ""
     except RecursionError as exc:
         raise LimitError(f"{name}: the SVG is nested too deeply to read") from exc
-    except _SVGELEMENTS_ERRORS as exc:
+    except SVGELEMENTS_ERRORS as exc:
         raise _diagnose(prepared, name, exc) from exc
 
     # Undo the viewBox -> viewport mapping svgelements applies: keep viewBox user units.
@@ -588,7 +578,7 @@ def _extract(prepared: _Prepared, name: str) -> tuple[list[Element], _Skips]:
                 skips.add(prepared.reasons.get(key, "degenerate (zero size)"))
                 continue
             style = _style(shape, vp_scale, opacity)
-        except _SVGELEMENTS_ERRORS:
+        except SVGELEMENTS_ERRORS:
             skips.add("invalid geometry")
             continue
         if style is None:
@@ -646,7 +636,7 @@ def _diagnose(prepared: _Prepared, name: str, exc: Exception) -> SvgError:
         seen.add(text)
         try:
             Matrix(text)
-        except (*_SVGELEMENTS_ERRORS, RecursionError):
+        except (*SVGELEMENTS_ERRORS, RecursionError):
             return SvgError(f"cannot read SVG {name}: invalid transform {_snippet(text)} on {where}")
     detail = str(exc).strip() or type(exc).__name__
     where = _failing_element(exc, prepared.names)

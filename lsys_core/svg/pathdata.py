@@ -42,6 +42,16 @@ _CLOSE_TOL = 1e-10
 
 #: Default significant digits of numbers written into path data (relative error <= 5e-9).
 DEFAULT_PRECISION = 9
+#: Exceptions svgelements raises on values it cannot handle (shared with the importer).
+SVGELEMENTS_ERRORS = (
+    ValueError,
+    TypeError,
+    IndexError,
+    KeyError,
+    AttributeError,
+    ZeroDivisionError,
+    OverflowError,
+)
 
 
 class RawPath(NamedTuple):
@@ -342,15 +352,7 @@ def cubics_from_d(d: str) -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
     snippet = d if len(d) <= 40 else d[:37] + "..."
     try:
         return cubics_from_path(Path(d))
-    except (
-        ValueError,
-        TypeError,
-        IndexError,
-        KeyError,
-        AttributeError,
-        ZeroDivisionError,
-        OverflowError,
-    ) as exc:
+    except SVGELEMENTS_ERRORS as exc:
         raise SvgError(f"invalid path data {snippet!r}") from exc
 
 
