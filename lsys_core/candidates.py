@@ -182,27 +182,34 @@ def _chains(src, dst, cost, n_nodes) -> tuple[list[list[int]], dict[int, int]]:
             continue
         succ[i] = j
         pred[j] = i
-    chains: list[list[int]] = []
+    paths, loops = _follow(succ, sorted(i for i in succ if i not in pred))
+    # Rings keep all their nodes; the pair closing the ring is dropped.
+    return paths + loops, succ
+
+
+def _follow(succ: dict[int, int], starts) -> tuple[list[list[int]], list[list[int]]]:
+    """Follow a successor map (≤ 1 successor and predecessor each) from ``starts`` into paths.
+
+    Returns the paths and the closed loops left over, each loop listed from its smallest item.
+    """
+    paths: list[list[int]] = []
     seen: set[int] = set()
-    starts = [i for i in succ if i not in pred]
-    for s0 in sorted(starts):
-        ch = [s0]
-        while ch[-1] in succ:
-            ch.append(succ[ch[-1]])
-        seen.update(ch)
-        chains.append(ch)
-    # Cycles (rings): cut each at its smallest node, dropping the closing pair.
-    for i in sorted(succ):
-        if i in seen:
+    for s0 in starts:
+        path = [s0]
+        while path[-1] in succ:
+            path.append(succ[path[-1]])
+        seen.update(path)
+        paths.append(path)
+    loops: list[list[int]] = []
+    for s0 in sorted(succ):
+        if s0 in seen:
             continue
-        cyc = [i]
-        while succ[cyc[-1]] != i:
-            cyc.append(succ[cyc[-1]])
-        k = int(np.argmin(cyc))
-        ch = cyc[k:] + cyc[:k]
-        seen.update(ch)
-        chains.append(ch)
-    return chains, succ
+        loop = [s0]
+        while succ[loop[-1]] != s0:
+            loop.append(succ[loop[-1]])
+        seen.update(loop)
+        loops.append(loop)
+    return paths, loops
 
 
 def _chain_pairs(chains, src, dst, idx) -> np.ndarray:
@@ -338,27 +345,9 @@ def _edge_chains(e1: np.ndarray, e2: np.ndarray) -> list[list[int]]:
     keep = e1 != e2
     nxt = dict(zip(e1[keep].tolist(), e2[keep].tolist(), strict=True))
     has_prev = set(nxt.values())
-    chains = []
-    seen: set[int] = set()
-    for s0 in nxt:
-        if s0 in has_prev:
-            continue
-        ch = [s0]
-        while ch[-1] in nxt:
-            ch.append(nxt[ch[-1]])
-        seen.update(ch)
-        chains.append(ch)
+    paths, loops = _follow(nxt, [s0 for s0 in nxt if s0 not in has_prev])
     # Closed loops (a ring of dots): cut each before its smallest pair and drop the closing one.
-    for s0 in sorted(nxt):
-        if s0 in seen:
-            continue
-        cyc = [s0]
-        while nxt.get(cyc[-1], s0) != s0 and len(cyc) <= len(nxt):
-            cyc.append(nxt[cyc[-1]])
-        seen.update(cyc)
-        if len(cyc) > 2:
-            chains.append(cyc[:-1])
-    return chains
+    return paths + [loop[:-1] for loop in loops if len(loop) > 2]
 
 
 def _linear_chains(bld, sym, ps, e1, e2, dA, dB, prox) -> Candidate | None:
