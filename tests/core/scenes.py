@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from lsys_core.geometry import DEG
-from lsys_core.model import Element, Scene
+from lsys_core.model import Drawing, Element, Scene
 
 #: An asymmetric leaf: two cubics from its base at the origin (local frame).
 LEAF = np.array(
@@ -46,3 +46,17 @@ def turtle_sequence(n: int, start, step) -> list[tuple[complex, complex]]:
         out.append((a, b))
         a, b = a * A, b + a * B
     return out
+
+
+def make_drawing(terminals, symbol, a, b, viewbox=None, size=None, rule: int = -1) -> Drawing:
+    """Return a Drawing of ``terminals`` with instances ``symbol`` at poses ``a``, ``b``."""
+    n = len(symbol)
+    return Drawing(
+        terminals=tuple(terminals),
+        symbol=np.asarray(symbol, dtype=np.int32),
+        a=np.asarray(a, dtype=complex),
+        b=np.asarray(b, dtype=complex),
+        rule=np.full(n, rule, np.int32),
+        viewbox=viewbox,
+        size=size,
+    )

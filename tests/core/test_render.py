@@ -13,20 +13,13 @@ from lsys_core.grammar.model import Terminal
 from lsys_core.model import Drawing
 from lsys_core.render import HIGHLIGHT, Renderer, render, render_png
 
+from .scenes import make_drawing
+
 SQUARE = "M0 0 L10 0 L10 10 L0 10 Z"
 
 
 def drawing_of(terminals, symbol, a, b, viewbox=(0.0, 0.0, 100.0, 100.0), size=None) -> Drawing:
-    n = len(symbol)
-    return Drawing(
-        terminals=tuple(terminals),
-        symbol=np.asarray(symbol, dtype=np.int32),
-        a=np.asarray(a, dtype=complex),
-        b=np.asarray(b, dtype=complex),
-        rule=np.zeros(n, np.int32),
-        viewbox=viewbox,
-        size=size,
-    )
+    return make_drawing(terminals, symbol, a, b, viewbox, size, rule=0)
 
 
 def test_filled_square_pixels():

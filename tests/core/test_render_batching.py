@@ -10,20 +10,14 @@ from lsys_core.grammar.model import Terminal
 from lsys_core.model import Drawing
 from lsys_core.render import Renderer
 
+from .scenes import make_drawing
+
 LEAF = "M0 0 C6 -6 16 -5 22 0 C15 3 6 6 0 0 Z"
 SQUARE = "M0 0 L10 0 L10 10 L0 10 Z"
 
 
 def drawing_of(terminals, symbol, a, b, viewbox=(0.0, 0.0, 400.0, 300.0)) -> Drawing:
-    n = len(symbol)
-    return Drawing(
-        terminals=tuple(terminals),
-        symbol=np.asarray(symbol, dtype=np.int32),
-        a=np.asarray(a, dtype=complex),
-        b=np.asarray(b, dtype=complex),
-        rule=np.zeros(n, np.int32),
-        viewbox=viewbox,
-    )
+    return make_drawing(terminals, symbol, a, b, viewbox, None, rule=0)
 
 
 def grid(rows: int, cols: int, step: float, turn: float = 0.0) -> tuple[np.ndarray, np.ndarray]:

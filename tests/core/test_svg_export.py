@@ -25,6 +25,8 @@ from lsys_core.svg import (
     sample_uniform,
 )
 
+from .scenes import make_drawing
+
 SHARED = Path(__file__).resolve().parents[2].parent / "shared"
 SVG_NS = "{http://www.w3.org/2000/svg}"
 
@@ -38,16 +40,7 @@ def shared() -> Path:
 
 
 def drawing_of(terminals, symbol, a, b, viewbox=None, size=None) -> Drawing:
-    n = len(symbol)
-    return Drawing(
-        terminals=tuple(terminals),
-        symbol=np.asarray(symbol, dtype=np.int32),
-        a=np.asarray(a, dtype=complex),
-        b=np.asarray(b, dtype=complex),
-        rule=np.full(n, -1, np.int32),
-        viewbox=viewbox,
-        size=size,
-    )
+    return make_drawing(terminals, symbol, a, b, viewbox, size, rule=-1)
 
 
 def identity_drawing(scene) -> Drawing:
