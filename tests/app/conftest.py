@@ -113,7 +113,7 @@ def window(make_window):
 def wait_idle(qtbot):
     """Return ``wait(win)``: wait until inference, derivation and rendering have finished."""
 
-    def wait(win, timeout: int = 30000) -> None:
+    def wait(win, timeout: int = 120_000) -> None:
         qtbot.waitUntil(win.is_idle, timeout=timeout)
 
     return wait

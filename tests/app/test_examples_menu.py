@@ -16,4 +16,6 @@ def test_open_example_menu_opens_a_file(window, qtbot) -> None:
     assert len(actions) == len(examples()) >= 6
     helix = next(a for a in actions if a.toolTip().endswith("helix.svg"))
     helix.trigger()
-    qtbot.waitUntil(lambda: window.doc.drawing is not None and len(window.doc.drawing) == 120, timeout=30000)
+    qtbot.waitUntil(
+        lambda: window.doc.drawing is not None and len(window.doc.drawing) == 120, timeout=120_000
+    )

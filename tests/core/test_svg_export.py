@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import re
-import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -214,7 +213,7 @@ def test_export_svg_writes_atomically(tmp_path):
         export_svg(dr, tmp_path / "missing" / "out.svg")
 
 
-def test_export_speed_100k():
+def test_export_of_100k_instances():
     leaf = Terminal("A", "M0 0 C6 -6 16 -5 22 0 C15 3 6 6 0 0 Z", "fill:#2e7d32")
     stem = Terminal("B", "M0 0 L10 0", "fill:none;stroke:#000")
     n = 100_000
@@ -226,8 +225,5 @@ def test_export_speed_100k():
         rng.uniform(0, 1000, n) + 1j * rng.uniform(0, 1000, n),
         (0, 0, 1000, 1000),
     )
-    start = time.perf_counter()
-    text = drawing_to_svg(dr)
-    elapsed = time.perf_counter() - start
+    text = drawing_to_svg(dr)  # speed: tests/bench/bench_svg.py
     assert text.count("<path ") == n
-    assert elapsed < 2.0  # target 1 s; generous for a loaded machine

@@ -5,7 +5,6 @@ from __future__ import annotations
 import gzip
 import json
 import math
-import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -361,10 +360,8 @@ HOSTILE = [
 
 @pytest.mark.parametrize(("label", "data", "error", "message"), HOSTILE, ids=[h[0] for h in HOSTILE])
 def test_hostile_input(label, data, error, message):
-    start = time.perf_counter()
-    with pytest.raises(error) as info:
+    with pytest.raises(error) as info:  # a hang fails by pytest-timeout; speed: make bench
         parse_svg(data)
-    assert time.perf_counter() - start < 2.0, label
     text = str(info.value)
     assert message in text
     assert "\n" not in text
@@ -417,7 +414,7 @@ def test_missing_file():
         load_svg("/nonexistent/file.svg")
 
 
-def test_import_speed():
+def test_import_of_many_paths():
     rng = np.random.default_rng(0)
     xy = rng.uniform(0, 1000, (3000, 2)).tolist()
     body = "".join(
@@ -425,8 +422,5 @@ def test_import_speed():
         for x, y in xy
     )
     text = svg(body, 'viewBox="0 0 1000 1000"')
-    start = time.perf_counter()
-    scene = parse_svg(text)
-    elapsed = time.perf_counter() - start
+    scene = parse_svg(text)  # speed: tests/bench/bench_svg.py
     assert len(scene.elements) == 3000
-    assert elapsed < 2.0  # the target is 10,000 paths in 2 s; this is 3,000
