@@ -1,8 +1,8 @@
-"""The canvas: the derived drawing rendered by ``lsys_core.render`` into a zero-copy QImage.
+"""The canvas: the derived drawing rendered by ``lsys_core.render.raster`` into a zero-copy QImage.
 
 Rendering runs on a worker (:class:`~app.workers.LatestRunner`): a request snapshots the
 drawing, the view (zoom, offset, device pixel ratio, size) and the quality; the worker draws
-with skia into one of two :class:`~lsys_core.render.Renderer` surfaces (double buffering: the
+with skia into one of two :class:`~lsys_core.render.raster.Renderer` surfaces (double buffering: the
 one on screen is never drawn into) and wraps the pixels as a QImage without copying; the UI
 thread only calls ``QPainter.drawImage``.  While the user drags a slider, pans or zooms, drafts
 are rendered (and the last frame is shown transformed to the new view until the next one

@@ -3,7 +3,7 @@
 The functions forward to the library (imported on first use, so the window appears before
 scipy and svgelements are loaded) and convert plain values (settings dicts, file reads) at
 the boundary.  The only arithmetic here is display bookkeeping: a bounding disc per terminal
-(from ``lsys_core.svg.export.terminal_points``) to pick the element under a click.  Nothing
+(from ``lsys_core.render.svg.terminal_points``) to pick the element under a click.  Nothing
 imports Qt (the inference worker process uses this module too).
 """
 
@@ -13,7 +13,7 @@ import dataclasses
 from pathlib import Path
 from typing import Any
 
-from lsys_core.derive import Randomize
+from lsys_core.derive.derivation import Randomize
 from lsys_core.errors import LsysError
 
 __all__ = [
@@ -122,14 +122,14 @@ def set_param(grammar: Any, key: str, value: float) -> Any:
 
 def replace_terminal(grammar: Any, name: str, path_d: str, style: str) -> Any:
     """Return ``grammar`` with terminal ``name`` drawing another shape."""
-    from lsys_core.edit import replace_terminal as _replace
+    from lsys_core.grammar.edit import replace_terminal as _replace
 
     return _replace(grammar, name, path_d, style)
 
 
 def replace_with_terminal(grammar: Any, nonterminal: str, terminal: str) -> Any:
     """Return ``grammar`` with every use of a non-terminal replaced by a terminal."""
-    from lsys_core.edit import replace_with_terminal as _replace
+    from lsys_core.grammar.edit import replace_with_terminal as _replace
 
     return _replace(grammar, nonterminal, terminal)
 
@@ -147,7 +147,7 @@ def shape_from_svg(path: str) -> tuple[str, str]:
     import numpy as np
 
     from lsys_core.errors import SvgError
-    from lsys_core.svg.pathdata import d_from_cubics
+    from lsys_core.geometry.paths import d_from_cubics
 
     scene = load_svg(path)
     if not scene.elements:
@@ -161,21 +161,21 @@ def shape_from_svg(path: str) -> tuple[str, str]:
 
 def export_svg(drawing: Any, path: str) -> None:
     """Write the drawing as an SVG file (atomically)."""
-    from lsys_core.svg.export import export_svg as _export
+    from lsys_core.render.svg import export_svg as _export
 
     _export(drawing, path)
 
 
 def export_png(drawing: Any, path: str, **options: Any) -> None:
     """Render the drawing into a PNG file."""
-    from lsys_core.render import render_png
+    from lsys_core.render.raster import render_png
 
     render_png(drawing, path, **options)
 
 
 def make_renderer(width: int, height: int) -> Any:
-    """Return a ``lsys_core.render.Renderer`` drawing into a ``width`` × ``height`` surface."""
-    from lsys_core.render import Renderer
+    """Return a ``lsys_core.render.raster.Renderer`` drawing into a ``width`` × ``height`` surface."""
+    from lsys_core.render.raster import Renderer
 
     return Renderer(width, height)
 
@@ -205,7 +205,7 @@ def _terminal_discs(drawing: Any) -> tuple[Any, Any]:
     """Return the centre (complex) and radius of a disc around every terminal's control points."""
     import numpy as np
 
-    from lsys_core.svg.export import terminal_points
+    from lsys_core.render.svg import terminal_points
 
     key = tuple(t.path for t in drawing.terminals)
     cached = _TERMINAL_DISCS.get(key)
@@ -237,7 +237,7 @@ def instance_radius(drawing: Any, index: int) -> float:
 
 def drawing_bounds(drawing: Any) -> tuple[float, float, float, float] | None:
     """Return ``(x0, y0, x1, y1)`` of the drawing's instances, strokes included (None if empty)."""
-    from lsys_core.svg.export import drawing_bounds as _bounds
+    from lsys_core.render.svg import drawing_bounds as _bounds
 
     return _bounds(drawing)
 

@@ -25,7 +25,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from lsys_core.derive import Randomize
+from lsys_core.derive.derivation import Randomize
 
 __all__ = ["RandomizeDialog", "ReplaceChoice", "ReplaceDialog"]
 
@@ -41,7 +41,7 @@ class RandomizeDialog(QDialog):
     Signals
     -------
     applied(randomize)
-        Emitted on Re-roll and Apply with the shown :class:`~lsys_core.derive.Randomize`.
+        Emitted on Re-roll and Apply with the shown :class:`~lsys_core.derive.derivation.Randomize`.
     """
 
     applied = Signal(object)

@@ -21,7 +21,7 @@ from typing import Any
 from PySide6.QtCore import QObject, QTimer, Signal
 from PySide6.QtGui import QUndoStack
 
-from lsys_core.derive import Randomize
+from lsys_core.derive.derivation import Randomize
 from lsys_core.errors import GrammarError, LsysError
 
 from . import core
@@ -34,7 +34,12 @@ __all__ = ["Document"]
 PARSE_DELAY_MS = 150
 INFER_DELAY_MS = 80
 #: Modules the inference process imports as it starts (while the window opens).
-INFER_PRELOAD = ("lsys_core.pipeline", "lsys_core.similarity", "lsys_core.svg.parse", "lsys_core.grammar")
+INFER_PRELOAD = (
+    "lsys_core.pipeline",
+    "lsys_core.instancing.similarity",
+    "lsys_core.svg.parse",
+    "lsys_core.grammar",
+)
 
 
 class Document(QObject):

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from lsys_core.cancel import CancelToken, Progress
-from lsys_core.derive import Randomize, derive
+from lsys_core.derive.derivation import Randomize, derive
 from lsys_core.errors import Cancelled, LsysError
 
 from . import core

@@ -506,7 +506,7 @@ class MainWindow(QMainWindow):
             self.show_message(f"Cannot replace: {exc}")
             return
         except ImportError:
-            self.show_message("Replacing symbols needs lsys_core.edit, which is not installed.")
+            self.show_message("Replacing symbols needs lsys_core.grammar.edit, which is not installed.")
             return
         self.doc.apply_grammar(new, label)
 

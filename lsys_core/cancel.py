@@ -5,7 +5,7 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 
-from .errors import Cancelled
+from lsys_core.errors import Cancelled
 
 __all__ = ["CancelToken", "Progress", "check", "report"]
 

@@ -17,8 +17,8 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from . import __version__
-from .errors import LsysError
+from lsys_core import __version__
+from lsys_core.errors import LsysError
 
 __all__ = ["main"]
 
@@ -111,7 +111,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _settings(args: argparse.Namespace):
-    from .pipeline import InferenceSettings
+    from lsys_core.pipeline import InferenceSettings
 
     kw = {k: getattr(args, k) for k in ("wn", "wh", "wphi", "wl", "similarity", "tolerance")}
     return InferenceSettings(**{k: v for k, v in kw.items() if v is not None})
@@ -131,8 +131,8 @@ def _read_text(path: str) -> str:
 
 
 def _load_rules(path: str):
-    from .errors import GrammarSyntaxError
-    from .grammar import parse_grammar
+    from lsys_core.errors import GrammarSyntaxError
+    from lsys_core.grammar import parse_grammar
 
     try:
         return parse_grammar(_read_text(path), check_paths=True)
@@ -161,14 +161,14 @@ def _derive(grammar, **options):
     """Derive quietly (numpy overflow warnings are not for the user; non-finite poses are checked on output)."""
     import numpy as np
 
-    from .derive import derive
+    from lsys_core.derive.derivation import derive
 
     with np.errstate(all="ignore"):
         return derive(grammar, **options)
 
 
 def _parse_randomize(text: str | None, seed: int):
-    from .derive import Randomize
+    from lsys_core.derive.derivation import Randomize
 
     if not text:
         return None
@@ -208,14 +208,14 @@ def _drawing_outputs(drawing, svg: str | None, png: str | None) -> list[tuple[st
     out: list[tuple[str, str | bytes]] = []
     if not (svg or png):
         return out
-    from .svg.export import check_finite, drawing_to_svg
+    from lsys_core.render.svg import check_finite, drawing_to_svg
 
     check_finite(drawing)  # an overflowing grammar is an error, not an empty or broken picture
     with np.errstate(all="ignore"):
         if svg:
             out.append((svg, drawing_to_svg(drawing)))
         if png:
-            from .render import encode_png
+            from lsys_core.render.raster import encode_png
 
             try:
                 out.append((png, encode_png(drawing)))
@@ -226,14 +226,14 @@ def _drawing_outputs(drawing, svg: str | None, png: str | None) -> list[tuple[st
 
 def _commit(files: list[tuple[str, str | bytes]]) -> None:
     """Write all output files at once: all of them or none."""
-    from .io import write_files_atomic
+    from lsys_core.io import write_files_atomic
 
     if files:
         write_files_atomic(files)
 
 
 def _infer_report(result, scene, drawing) -> dict:
-    from .grammar import format_grammar
+    from lsys_core.grammar import format_grammar
 
     g = result.grammar
     text = format_grammar(g)
@@ -256,10 +256,10 @@ def _infer_report(result, scene, drawing) -> dict:
 
 
 def _cmd_infer(args, progress: _Progress, symmetrize: bool = False) -> int:
-    from .grammar import format_grammar
-    from .pipeline import infer
-    from .pipeline import symmetrize as sym_fn
-    from .svg.parse import load_svg
+    from lsys_core.grammar import format_grammar
+    from lsys_core.pipeline import infer
+    from lsys_core.pipeline import symmetrize as sym_fn
+    from lsys_core.svg.parse import load_svg
 
     if symmetrize:
         _check_outputs([args.output, args.rules])
@@ -306,8 +306,8 @@ def _cmd_infer(args, progress: _Progress, symmetrize: bool = False) -> int:
 
 
 def _cmd_derive(args) -> int:
-    from .derive import DEFAULT_LIMIT
-    from .grammar import set_params
+    from lsys_core.derive.derivation import DEFAULT_LIMIT
+    from lsys_core.grammar import set_params
 
     _check_outputs([args.output, args.png])
     limit = DEFAULT_LIMIT if args.limit is None else args.limit
@@ -328,7 +328,7 @@ def _cmd_derive(args) -> int:
 
 
 def _cmd_params(args) -> int:
-    from .grammar import list_params
+    from lsys_core.grammar import list_params
 
     g = _load_rules(args.rules)
     for p in list_params(g):

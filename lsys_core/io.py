@@ -16,7 +16,7 @@ import secrets
 from collections.abc import Iterable
 from pathlib import Path
 
-from .errors import LsysError
+from lsys_core.errors import LsysError
 
 __all__ = ["write_atomic", "write_files_atomic"]
 

@@ -1,4 +1,4 @@
-"""The whole inference, from a :class:`~lsys_core.model.Scene` to a :class:`Grammar`.
+"""The whole inference, from a :class:`~lsys_core.svg.model.Scene` to a :class:`Grammar`.
 
 >>> from lsys_core.svg.parse import load_svg              # doctest: +SKIP
 >>> result = infer(load_svg("helix.svg"))                 # doctest: +SKIP
@@ -12,16 +12,17 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .cancel import CancelToken, Progress, check, report
-from .derive import derive
-from .errors import InferenceError
-from .fidelity import split_unfaithful
-from .grammar.model import Grammar
-from .inference import Tolerance, Weights, build_hierarchy
-from .model import Instancing, Scene
-from .orientation import unwrap_symmetric
-from .pivots import estimate_pivots, recenter
-from .postprocess import simplify
+from lsys_core.cancel import CancelToken, Progress, check, report
+from lsys_core.derive.derivation import derive
+from lsys_core.errors import InferenceError
+from lsys_core.grammar.model import Grammar
+from lsys_core.hierarchy.pivots import estimate_pivots, recenter
+from lsys_core.hierarchy.postprocess import simplify
+from lsys_core.hierarchy.rules import Tolerance, Weights, build_hierarchy
+from lsys_core.instancing.fidelity import split_unfaithful
+from lsys_core.instancing.model import Instancing
+from lsys_core.instancing.orientation import unwrap_symmetric
+from lsys_core.svg.model import Scene
 
 __all__ = ["InferenceResult", "InferenceSettings", "infer", "symmetrize"]
 
@@ -111,7 +112,7 @@ def _element_circles(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
 
 def _shape_similarity(inst: Instancing, cancel: CancelToken | None) -> np.ndarray:
     """Similarity of pairs of terminals for the importance's φ (§5.4, mirror images count as alike)."""
-    from .similarity import terminal_similarity
+    from lsys_core.instancing.similarity import terminal_similarity
 
     if len(inst.terminals) > 64:  # pairwise shape matching; beyond this a constant keeps it cheap
         k = len(inst.terminals)
@@ -209,7 +210,7 @@ def infer(
     -------
     InferenceResult
     """
-    from .similarity import detect_similarity
+    from lsys_core.instancing.similarity import detect_similarity
 
     settings = settings.validated()
     if not scene.elements:

@@ -10,14 +10,15 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .model import Drawing, Scene
+from lsys_core.derive.model import Drawing
+from lsys_core.svg.model import Scene
 
 __all__ = ["assert_scenes_close", "drawing_scene", "hausdorff_rel", "regularity", "scene_points"]
 
 
 def scene_points(scene: Scene, per_segment: int = 8) -> np.ndarray:
     """Return points sampled along every element of ``scene`` as an ``(n, 2)`` array."""
-    from .svg.pathdata import sample_cubics
+    from lsys_core.geometry.bezier import sample_cubics
 
     cubics = np.concatenate([e.cubics for e in scene.elements])
     pts = sample_cubics(cubics, per_segment)
@@ -42,8 +43,8 @@ def regularity(scene: Scene) -> float:
 
 def drawing_scene(drawing: Drawing) -> Scene:
     """Return ``drawing`` as the SVG importer reads it back (what a user's other tools see)."""
-    from .svg.export import drawing_to_svg
-    from .svg.parse import parse_svg
+    from lsys_core.render.svg import drawing_to_svg
+    from lsys_core.svg.parse import parse_svg
 
     return parse_svg(drawing_to_svg(drawing))
 

@@ -14,10 +14,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from lsys_core.derive import derive  # noqa: E402
+from lsys_core.derive.derivation import derive  # noqa: E402
 from lsys_core.grammar import parse_grammar  # noqa: E402
-from lsys_core.render import render_png  # noqa: E402
-from lsys_core.svg.export import export_svg  # noqa: E402
+from lsys_core.render.raster import render_png  # noqa: E402
+from lsys_core.render.svg import export_svg  # noqa: E402
 
 __all__ = ["APP_ID", "SIZES", "main"]
 

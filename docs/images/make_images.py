@@ -20,13 +20,13 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from lsys_core.derive import derive  # noqa: E402
+from lsys_core.derive.derivation import derive  # noqa: E402
+from lsys_core.derive.model import Drawing  # noqa: E402
+from lsys_core.geometry.paths import d_from_cubics  # noqa: E402
 from lsys_core.grammar import Grammar, Terminal, parse_grammar, set_params  # noqa: E402
-from lsys_core.model import Drawing  # noqa: E402
 from lsys_core.pipeline import symmetrize  # noqa: E402
-from lsys_core.render import default_view, render  # noqa: E402
+from lsys_core.render.raster import default_view, render  # noqa: E402
 from lsys_core.svg.parse import load_svg  # noqa: E402
-from lsys_core.svg.pathdata import d_from_cubics  # noqa: E402
 
 __all__ = ["EDITS", "main"]
 

@@ -5,7 +5,7 @@
 
 from __future__ import annotations
 
-from .model import (
+from lsys_core.grammar.model import (
     COND_EQ0,
     COND_GT0,
     Case,
@@ -20,9 +20,9 @@ from .model import (
     Terminal,
     Turtle,
 )
-from .params import Param, list_params, set_param, set_params
-from .text import format_grammar, parse_grammar
-from .validate import validate
+from lsys_core.grammar.params import Param, list_params, set_param, set_params
+from lsys_core.grammar.text import format_grammar, parse_grammar
+from lsys_core.grammar.validate import validate
 
 __all__ = [
     "COND_EQ0",

@@ -24,9 +24,9 @@ from collections import Counter
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, replace
 
-from ..errors import GrammarError
-from .model import Grammar, Linear, Module, Symbol, Turtle
-from .validate import COUNT_LIMIT
+from lsys_core.errors import GrammarError
+from lsys_core.grammar.model import Grammar, Linear, Module, Symbol, Turtle
+from lsys_core.grammar.validate import COUNT_LIMIT
 
 __all__ = ["KINDS", "Param", "list_params", "set_param", "set_params"]
 

@@ -21,8 +21,8 @@ import re
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
-from ..errors import GrammarSyntaxError
-from .model import (
+from lsys_core.errors import GrammarSyntaxError
+from lsys_core.grammar.model import (
     COND_EQ0,
     COND_GT0,
     Case,
@@ -37,7 +37,7 @@ from .model import (
     Terminal,
     Turtle,
 )
-from .validate import KEYWORDS, RESERVED, Problem, count_text, find_problems, path_problem
+from lsys_core.grammar.validate import KEYWORDS, RESERVED, Problem, count_text, find_problems, path_problem
 
 __all__ = ["FORMAT_VERSION", "format_grammar", "parse_grammar"]
 

@@ -26,8 +26,20 @@ from typing import Literal
 
 import numpy as np
 
-from ..errors import GrammarError
-from .model import COND_EQ0, COND_GT0, Count, Grammar, Linear, Module, Pop, Push, Rule, Symbol, Turtle
+from lsys_core.errors import GrammarError
+from lsys_core.grammar.model import (
+    COND_EQ0,
+    COND_GT0,
+    Count,
+    Grammar,
+    Linear,
+    Module,
+    Pop,
+    Push,
+    Rule,
+    Symbol,
+    Turtle,
+)
 
 __all__ = [
     "COUNT_LIMIT",
@@ -365,9 +377,8 @@ def path_problem(d: str) -> str | None:
     str or None
         ``"invalid path data ..."`` or ``"path data has non-finite or huge coordinates"``.
     """
-    from ..errors import SvgError
-    from ..svg.parse import MAX_COORD
-    from ..svg.pathdata import cubics_from_d
+    from lsys_core.errors import SvgError
+    from lsys_core.geometry.paths import MAX_COORD, cubics_from_d
 
     if not d.strip():
         return None

@@ -1,20 +1,12 @@
-"""SVG input and output: safe parsing into a Scene, path data as cubic arrays, export of a Drawing."""
+"""Stage 1, input: read an SVG file safely into a :class:`Scene` of :class:`Element` s.
+
+>>> from lsys_core.svg import load_svg   # doctest: +SKIP
+>>> scene = load_svg("flag.svg")          # doctest: +SKIP
+"""
 
 from __future__ import annotations
 
-from .export import drawing_bounds, drawing_to_svg, export_svg
-from .parse import load_svg, parse_svg
-from .pathdata import cubics_from_d, cubics_from_path, d_from_cubics, sample_cubics, sample_uniform
+from lsys_core.svg.model import Element, Scene
+from lsys_core.svg.parse import load_svg, parse_svg
 
-__all__ = [
-    "cubics_from_d",
-    "cubics_from_path",
-    "d_from_cubics",
-    "drawing_bounds",
-    "drawing_to_svg",
-    "export_svg",
-    "load_svg",
-    "parse_svg",
-    "sample_cubics",
-    "sample_uniform",
-]
+__all__ = ["Element", "Scene", "load_svg", "parse_svg"]

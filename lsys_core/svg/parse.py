@@ -1,11 +1,11 @@
-"""Read an SVG file into a :class:`~lsys_core.model.Scene`, safely.
+"""Read an SVG file into a :class:`~lsys_core.svg.model.Scene`, safely.
 
 The bytes are checked before any SVG library sees them: size, binary junk, XML
 attacks (entities, internal DTD subsets), nesting depth, ``<use>`` cycles and
 ``<use>`` fan-out.  The checked tree is re-serialised (without DTD, with the
 content of ``<symbol>``, ``<mask>`` and ``<marker>`` moved out of the drawing
 flow) and handed to svgelements, which resolves CSS, inheritance, ``<use>`` and
-transforms.  Each drawable shape becomes an :class:`~lsys_core.model.Element`
+transforms.  Each drawable shape becomes an :class:`~lsys_core.svg.model.Element`
 with cubic Bézier arrays in viewBox user units and a resolved style string.
 """
 
@@ -23,9 +23,16 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import LimitError, SvgError
-from ..model import Element, Scene
-from .pathdata import SVGELEMENTS_ERRORS, RawPath, assemble, raw_from_d, raw_from_segments
+from lsys_core.errors import LimitError, SvgError
+from lsys_core.geometry.paths import (
+    MAX_COORD,
+    SVGELEMENTS_ERRORS,
+    RawPath,
+    assemble,
+    raw_from_d,
+    raw_from_segments,
+)
+from lsys_core.svg.model import Element, Scene
 
 __all__ = ["DEFAULT_MAX_BYTES", "DEFAULT_MAX_DEPTH", "DEFAULT_MAX_ELEMENTS", "load_svg", "parse_svg"]
 
@@ -33,7 +40,6 @@ DEFAULT_MAX_BYTES = 50_000_000
 DEFAULT_MAX_ELEMENTS = 200_000
 DEFAULT_MAX_DEPTH = 500
 #: Coordinates beyond this magnitude are treated as broken input.
-MAX_COORD = 1e12
 
 SVG_NS = "{http://www.w3.org/2000/svg}"
 XLINK_HREF = "{http://www.w3.org/1999/xlink}href"

@@ -9,7 +9,7 @@ from PySide6.QtGui import QDropEvent, QKeySequence, QTextCursor
 from PySide6.QtWidgets import QMessageBox
 
 from app import core
-from lsys_core.derive import Randomize
+from lsys_core.derive.derivation import Randomize
 
 
 def _open(window, path, wait_idle):
@@ -184,7 +184,7 @@ def test_randomize_dialog_reroll_applies_a_new_seed(window, helix_lsys, wait_idl
 
 
 def test_replace_nonterminal_by_terminal(window, tmp_path, wait_idle):
-    pytest.importorskip("lsys_core.edit")
+    pytest.importorskip("lsys_core.grammar.edit")
     from app.dialogs import ReplaceDialog
 
     path = tmp_path / "rows.lsys"
@@ -210,7 +210,7 @@ def test_replace_nonterminal_by_terminal(window, tmp_path, wait_idle):
 
 
 def test_replace_terminal_shape(window, helix_lsys, wait_idle):
-    pytest.importorskip("lsys_core.edit")
+    pytest.importorskip("lsys_core.grammar.edit")
     from app.dialogs import ReplaceChoice
 
     _open(window, helix_lsys, wait_idle)

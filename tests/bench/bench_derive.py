@@ -8,9 +8,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from lsys_core.derive import derive
+from lsys_core.derive.derivation import derive
 from lsys_core.grammar import parse_grammar
-from lsys_core.svg.export import export_svg
+from lsys_core.render.svg import export_svg
 
 HEAD = 'lsys 1\nterminal A "M0 0 C3 -5 8 -6 14 -2 C10 1 6 1 0 0 Z"\n'
 CASES = {

@@ -9,7 +9,7 @@ Reports, in milliseconds:
   (full anti-aliased quality; target ≤ 100 ms for 10,000).  Each move is timed from
   ``QSlider.setValue`` on the UI thread to the end of a synchronous ``repaint()`` that shows
   the frame of the new value.  The drag bends every row into overlapping coils, so the
-  released frame is drawn instance by instance (``lsys_core.render`` batches full-quality
+  released frame is drawn instance by instance (``lsys_core.render.raster`` batches full-quality
   frames only where instances do not overlap: see ``bench_render.py``'s "rows" scene).
 * the longest UI-thread stall while inference of a 1,200-element scene runs in the background,
   with inference in a worker thread and in a worker process: a 2 ms QTimer on the UI thread
@@ -133,7 +133,7 @@ def bench_slider(app, workdir: Path, rows: int, cols: int, moves: int) -> dict:
         win.doc.undo_stack.undo()
         wait_until(app, win.is_idle)
     t0 = time.perf_counter()
-    from lsys_core.derive import derive
+    from lsys_core.derive.derivation import derive
 
     for _ in range(5):
         derive(win.doc.grammar)
@@ -156,9 +156,9 @@ def bench_stall(app, workdir: Path, in_process: bool, seconds: float) -> dict:
     from PySide6.QtCore import QTimer
 
     from app.jobs import run_inference
-    from lsys_core.derive import derive
+    from lsys_core.derive.derivation import derive
     from lsys_core.grammar import parse_grammar
-    from lsys_core.svg.export import export_svg
+    from lsys_core.render.svg import export_svg
 
     svg = workdir / "scene1200.svg"
     if not svg.exists():

@@ -13,9 +13,9 @@ import time
 
 import numpy as np
 
+from lsys_core.derive.model import Drawing
 from lsys_core.grammar.model import Terminal
-from lsys_core.model import Drawing
-from lsys_core.render import Renderer
+from lsys_core.render.raster import Renderer
 
 WIDTH, HEIGHT = 1600, 1200
 LEAF = Terminal("A", "M0 0 C6 -6 16 -5 22 0 C15 3 6 6 0 0 Z", "fill:#2e7d32;stroke:#1b5e20;stroke-width:0.5")

@@ -16,8 +16,8 @@ from itertools import pairwise
 
 import numpy as np
 
-from lsys_core.model import Element, Scene
-from lsys_core.similarity import detect_similarity
+from lsys_core.instancing.similarity import detect_similarity
+from lsys_core.svg.model import Element, Scene
 
 REPEAT = 3
 STYLE = "fill:none;stroke:#1b5e20;stroke-width:1"

@@ -11,9 +11,11 @@ from pathlib import Path
 
 import numpy as np
 
+from lsys_core.derive.model import Drawing
+from lsys_core.geometry import d_from_cubics
 from lsys_core.grammar.model import Terminal
-from lsys_core.model import Drawing
-from lsys_core.svg import d_from_cubics, export_svg, load_svg
+from lsys_core.render import export_svg
+from lsys_core.svg import load_svg
 
 
 def write_paths(path: Path, n: int, seed: int = 0) -> None:

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from lsys_core.geometry import DEG
-from lsys_core.model import Drawing, Element, Scene
+from lsys_core.derive.model import Drawing
+from lsys_core.geometry.transforms import DEG
+from lsys_core.svg.model import Element, Scene
 
 #: An asymmetric leaf: two cubics from its base at the origin (local frame).
 LEAF = np.array(
@@ -37,7 +38,7 @@ def scene(*groups: list[Element]) -> Scene:
 
 def turtle_sequence(n: int, start, step) -> list[tuple[complex, complex]]:
     """Frames of ``P(n-1)`` with ``P(m) -> A T P(m-1)``: ``T`` is ``(alpha, d, s, beta)``."""
-    from lsys_core.geometry import rel_from_t4
+    from lsys_core.geometry.transforms import rel_from_t4
 
     A, B = rel_from_t4(*step)
     a, b = start

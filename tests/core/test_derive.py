@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lsys_core.derive import Randomize, derive
+from lsys_core.derive.derivation import Randomize, derive
 from lsys_core.errors import LimitError
 from lsys_core.grammar import parse_grammar
 

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lsys_core.derive import derive
-from lsys_core.edit import replace_terminal, replace_with_terminal, set_axiom_count
+from lsys_core.derive.derivation import derive
 from lsys_core.errors import GrammarError
 from lsys_core.grammar import parse_grammar
+from lsys_core.grammar.edit import replace_terminal, replace_with_terminal, set_axiom_count
 
 GRID = """lsys 1
 terminal A "M0 0 L10 0 L10 10 Z" style "fill:#000"

@@ -9,11 +9,11 @@ from pathlib import Path
 
 import pytest
 
-from lsys_core.derive import Randomize, derive
+from lsys_core.derive.derivation import Randomize, derive
 from lsys_core.grammar import parse_grammar
-from lsys_core.model import Scene
 from lsys_core.pipeline import symmetrize
-from lsys_core.svg.export import drawing_to_svg
+from lsys_core.render.svg import drawing_to_svg
+from lsys_core.svg.model import Scene
 from lsys_core.svg.parse import load_svg, parse_svg
 from lsys_core.testing import hausdorff_rel, regularity
 

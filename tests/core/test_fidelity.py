@@ -6,7 +6,7 @@ import itertools
 
 import numpy as np
 
-from lsys_core.derive import derive
+from lsys_core.derive.derivation import derive
 from lsys_core.pipeline import infer
 
 from .scenes import place, pose, scene

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lsys_core.derive import derive
+from lsys_core.derive.derivation import derive
 from lsys_core.grammar import Symbol, Turtle, format_grammar, parse_grammar
 from lsys_core.pipeline import InferenceSettings, infer, reproduction_error, symmetrize
 
@@ -78,7 +78,7 @@ def test_grid_is_two_nested_sequences() -> None:
 
 
 def test_fig1_branching_is_one_rule() -> None:
-    from lsys_core.derive import derive as d2
+    from lsys_core.derive.derivation import derive as d2
 
     g = parse_grammar(
         'lsys 1\nterminal A "M0 0 C8 -3 30 -6 40 0 C30 4 14 5 0 0 Z"\naxiom: R(3)\n'
@@ -86,7 +86,7 @@ def test_fig1_branching_is_one_rule() -> None:
         "R(m): m == 0 -> A\n"
     )
     truth = d2(g)
-    from lsys_core.svg.pathdata import cubics_from_d
+    from lsys_core.geometry.paths import cubics_from_d
 
     shape = cubics_from_d(g.terminals[0].path)[0]
     sc = scene(place(shape, zip(truth.a, truth.b, strict=True)))

@@ -22,7 +22,7 @@ def test_core_imports_no_qt() -> None:
 
 def test_infer_path_does_not_import_skia() -> None:
     code = (
-        "import sys, lsys_core.cli, lsys_core.pipeline, lsys_core.svg.parse, lsys_core.derive; "
+        "import sys, lsys_core.cli, lsys_core.pipeline, lsys_core.svg.parse, lsys_core.derive.derivation; "
         "print('skia' in sys.modules)"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)

@@ -12,7 +12,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from lsys_core.derive import derive
+from lsys_core.derive.derivation import derive
 from lsys_core.grammar import parse_grammar
 from lsys_core.svg.parse import load_svg
 

@@ -10,7 +10,7 @@ import json
 
 import pytest
 
-from lsys_core.derive import derive
+from lsys_core.derive.derivation import derive
 from lsys_core.pipeline import infer
 from lsys_core.svg.parse import load_svg
 from lsys_core.testing import assert_scenes_close, drawing_scene

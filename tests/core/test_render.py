@@ -8,10 +8,10 @@ import zlib
 import numpy as np
 import pytest
 
+from lsys_core.derive.model import Drawing
 from lsys_core.errors import LsysError
 from lsys_core.grammar.model import Terminal
-from lsys_core.model import Drawing
-from lsys_core.render import HIGHLIGHT, Renderer, render, render_png
+from lsys_core.render.raster import HIGHLIGHT, Renderer, render, render_png
 
 from .scenes import make_drawing
 

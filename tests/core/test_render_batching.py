@@ -5,10 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lsys_core import render, render_paths
+from lsys_core.derive.model import Drawing
 from lsys_core.grammar.model import Terminal
-from lsys_core.model import Drawing
-from lsys_core.render import Renderer
+from lsys_core.render import paths as render_paths
+from lsys_core.render import raster as render
+from lsys_core.render.raster import Renderer
 
 from .scenes import make_drawing
 

@@ -10,9 +10,14 @@ import pytest
 
 from lsys_core.cancel import CancelToken
 from lsys_core.errors import Cancelled, InferenceError
-from lsys_core.model import Element, Scene
-from lsys_core.similarity import detect_similarity, symmetry_order, terminal_name, terminal_similarity
-from lsys_core.similarity_sampling import arc_fractions, element_features, sample_elements
+from lsys_core.instancing.sampling import arc_fractions, element_features, sample_elements
+from lsys_core.instancing.similarity import (
+    detect_similarity,
+    symmetry_order,
+    terminal_name,
+    terminal_similarity,
+)
+from lsys_core.svg.model import Element, Scene
 
 CORPUS = Path("/work/shared/corpus")
 STYLE = "fill:none;stroke:#1b5e20;stroke-width:1"
@@ -278,7 +283,7 @@ def test_threshold_decides_whether_a_deformed_copy_joins():
 
 
 def test_terminal_path_is_the_representative_about_its_centroid():
-    from lsys_core.svg import pathdata
+    from lsys_core.geometry import paths as pathdata
 
     shape = 3 * np.exp(0.7j) * LEAF + (120 + 40j)
     inst = detect_similarity(Scene((el(shape), el(LEAF))))

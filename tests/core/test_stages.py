@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from lsys_core.cancel import CancelToken
-from lsys_core.clustering import mean_shift
 from lsys_core.errors import Cancelled
-from lsys_core.geometry import rel_from_t4, t4_from_rel
+from lsys_core.geometry.transforms import rel_from_t4, t4_from_rel
+from lsys_core.hierarchy.clustering import mean_shift
+from lsys_core.hierarchy.spaces import pair_space
 from lsys_core.pipeline import infer
-from lsys_core.transforms import pair_space
 
 from .scenes import LEAF, place, pose, scene
 

@@ -9,20 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from lsys_core.derive.model import Drawing
 from lsys_core.errors import LsysError
+from lsys_core.geometry import cubics_from_d, d_from_cubics, sample_cubics, sample_uniform
 from lsys_core.grammar.model import Terminal
-from lsys_core.model import Drawing
-from lsys_core.svg import (
-    cubics_from_d,
-    d_from_cubics,
-    drawing_bounds,
-    drawing_to_svg,
-    export_svg,
-    load_svg,
-    parse_svg,
-    sample_cubics,
-    sample_uniform,
-)
+from lsys_core.render import drawing_bounds, drawing_to_svg, export_svg
+from lsys_core.svg import load_svg, parse_svg
 
 from .scenes import make_drawing
 

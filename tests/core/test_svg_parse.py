@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from lsys_core.errors import LimitError, LsysError, SvgError
-from lsys_core.svg import cubics_from_d, load_svg, parse_svg, sample_cubics, sample_uniform
+from lsys_core.geometry import cubics_from_d, sample_cubics, sample_uniform
+from lsys_core.svg import load_svg, parse_svg
 
 SHARED = Path(__file__).resolve().parents[2].parent / "shared"
 NS = 'xmlns="http://www.w3.org/2000/svg"'

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from lsys_core.derive import derive
+from lsys_core.derive.derivation import derive
 from lsys_core.grammar import parse_grammar
-from lsys_core.svg.export import export_svg
+from lsys_core.render.svg import export_svg
 
 from .shared import CORPUS, ROOT, compare_svg, need
 

@@ -10,9 +10,10 @@ from __future__ import annotations
 import numpy as np
 
 from lsys_core.errors import GrammarSyntaxError, LsysError
+from lsys_core.geometry.paths import MAX_COORD
 from lsys_core.grammar import Grammar, format_grammar, parse_grammar
-from lsys_core.model import Scene
-from lsys_core.svg.parse import MAX_COORD, parse_svg
+from lsys_core.svg.model import Scene
+from lsys_core.svg.parse import parse_svg
 
 __all__ = ["check_lsys_text", "check_message", "check_scene", "check_svg_import"]
 

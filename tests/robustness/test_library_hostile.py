@@ -13,15 +13,17 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from lsys_core import cli, render
+from lsys_core import cli
 from lsys_core import io as lio
-from lsys_core.derive import derive
+from lsys_core.derive.derivation import derive
+from lsys_core.derive.model import Drawing
 from lsys_core.errors import GrammarSyntaxError, LsysError
 from lsys_core.grammar import parse_grammar
 from lsys_core.io import write_files_atomic
-from lsys_core.model import Drawing
-from lsys_core.render import encode_png
-from lsys_core.svg import drawing_to_svg, export_svg, parse_svg
+from lsys_core.render import drawing_to_svg, export_svg
+from lsys_core.render import raster as render
+from lsys_core.render.raster import encode_png
+from lsys_core.svg import parse_svg
 
 from .generators import SHAPE, hostile_rules, svg
 

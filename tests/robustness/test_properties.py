@@ -16,10 +16,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from lsys_core.derive import derive
+from lsys_core.derive.derivation import derive
 from lsys_core.errors import GrammarError, LimitError, LsysError, SvgError
 from lsys_core.grammar import list_params, parse_grammar, set_param
-from lsys_core.svg import drawing_to_svg, parse_svg
+from lsys_core.render import drawing_to_svg
+from lsys_core.svg import parse_svg
 
 from .generators import SHAPE, hostile_svgs, lsys_texts, svg, svg_bytes, svg_documents
 from .oracles import check_lsys_text, check_scene, check_svg_import

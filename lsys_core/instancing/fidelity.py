@@ -16,8 +16,9 @@ from dataclasses import replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .cancel import CancelToken
-from .model import Element, Instancing, Scene
+from lsys_core.cancel import CancelToken
+from lsys_core.instancing.model import Instancing
+from lsys_core.svg.model import Element, Scene
 
 __all__ = ["deviation_tolerance", "split_unfaithful"]
 
@@ -31,8 +32,8 @@ def _deviations(
     scene: Scene, inst: Instancing, radius: np.ndarray, tol: float, absolute: float
 ) -> np.ndarray:
     """Deviation of every element from its posed terminal, in units of its allowance (> 1: too far)."""
-    from .similarity_sampling import arc_fractions, sample_elements
-    from .svg.pathdata import cubics_from_d
+    from lsys_core.geometry.paths import cubics_from_d
+    from lsys_core.instancing.sampling import arc_fractions, sample_elements
 
     els = sample_elements(scene.elements, arc_fractions(48))
     terms = tuple(Element(*cubics_from_d(t.path)) for t in inst.terminals)
@@ -71,7 +72,7 @@ def split_unfaithful(
     scene : Scene
         The imported elements.
     inst : Instancing
-        Result of :func:`~lsys_core.similarity.detect_similarity` on ``scene``.
+        Result of :func:`~lsys_core.instancing.similarity.detect_similarity` on ``scene``.
     radius : ndarray
         Radius of every element (its size for the relative deviation).
     threshold : float
@@ -81,7 +82,7 @@ def split_unfaithful(
     rounds : int
         Regrouping rounds; what still deviates afterwards becomes a terminal of its own.
     """
-    from .similarity import detect_similarity, terminal_name
+    from lsys_core.instancing.similarity import detect_similarity, terminal_name
 
     tol = deviation_tolerance(threshold)
     for r in range(rounds + 1):
@@ -98,9 +99,9 @@ def split_unfaithful(
 
 
 def _singletons(sub: Scene) -> Instancing:
-    from .grammar.model import Terminal
-    from .similarity import terminal_name
-    from .svg.pathdata import d_from_cubics
+    from lsys_core.geometry.paths import d_from_cubics
+    from lsys_core.grammar.model import Terminal
+    from lsys_core.instancing.similarity import terminal_name
 
     terms, bs = [], []
     for k, e in enumerate(sub.elements):

@@ -4,8 +4,8 @@ The scene is a set of *live nodes*: at first the input elements (terminal instan
 their poses), later non-terminal instances covering groups of elements.  Each level:
 
 1. pair every node with its nearest neighbours and measure the relative transforms
-   (:mod:`lsys_core.transforms`);
-2. cluster them by mean shift (:mod:`lsys_core.clustering`) in each space of a pair of
+   (:mod:`lsys_core.hierarchy.spaces`);
+2. cluster them by mean shift (:mod:`lsys_core.hierarchy.clustering`) in each space of a pair of
    symbols: clusters *C* of (nearly) equal transforms, and clusters *D* in the (d, s)
    subspace whose α and β change by a constant step along a sequence;
 3. turn clusters into candidate rules: sequences (chains of pairs), branchings (two
@@ -24,11 +24,23 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .cancel import CancelToken, Progress, check, report
-from .candidates import Candidate, find_candidates
-from .geometry import t4_from_rel, wrap_deg
-from .grammar.model import COND_EQ0, COND_GT0, Case, Count, Linear, Module, Pop, Push, Rule, Symbol, Turtle
-from .transforms import pair_space
+from lsys_core.cancel import CancelToken, Progress, check, report
+from lsys_core.geometry.transforms import t4_from_rel, wrap_deg
+from lsys_core.grammar.model import (
+    COND_EQ0,
+    COND_GT0,
+    Case,
+    Count,
+    Linear,
+    Module,
+    Pop,
+    Push,
+    Rule,
+    Symbol,
+    Turtle,
+)
+from lsys_core.hierarchy.candidates import Candidate, find_candidates
+from lsys_core.hierarchy.spaces import pair_space
 
 __all__ = ["Hierarchy", "Tolerance", "Weights", "build_hierarchy"]
 

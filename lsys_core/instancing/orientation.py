@@ -18,7 +18,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import breadth_first_order, connected_components, minimum_spanning_tree
 from scipy.spatial import cKDTree
 
-from .model import Instancing
+from lsys_core.instancing.model import Instancing
 
 __all__ = ["unwrap_symmetric"]
 

@@ -1,6 +1,6 @@
 """Match a batch of candidate elements against one representative (§4.1, steps 2–7).
 
-Helpers of :mod:`lsys_core.similarity`.  Both shapes are centred on their centroids and
+Helpers of :mod:`lsys_core.instancing.similarity`.  Both shapes are centred on their centroids and
 normalised by their RMS radius (the paper normalises by the largest sample distance; the
 RMS radius is as cheap and steadier under resampling).
 
@@ -25,7 +25,7 @@ import numpy as np
 from scipy.ndimage import uniform_filter1d
 from scipy.spatial import cKDTree
 
-from .similarity_sampling import Samples, bezier
+from lsys_core.instancing.sampling import Samples, bezier
 
 __all__ = ["PERFECT", "Batch", "MatchResult", "Reference", "match_batch"]
 

@@ -1,8 +1,8 @@
-"""Derive a grammar into a :class:`~lsys_core.model.Drawing`: rewriting and turtle interpretation.
+"""Derive a grammar into a :class:`~lsys_core.derive.model.Drawing`: rewriting and turtle interpretation.
 
 The derivation is level-batched and vectorised: all pending calls of one non-terminal are
 expanded at once, each as numpy arrays of counters ``m`` and turtle frames ``(a, b)``
-(complex, see :mod:`lsys_core.geometry`).  A case that ends with a call to its own symbol
+(complex, see :mod:`lsys_core.geometry.transforms`).  A case that ends with a call to its own symbol
 with ``m - c`` (a *sequence*, the paper's r1) is unrolled in one step: the frames of all
 ``m`` repetitions are a segmented cumulative product, so a 10⁶-element sequence costs a
 few numpy calls, not 10⁶ Python iterations.  Branching rules (r3) take one batch per level.
@@ -19,11 +19,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .cancel import CancelToken, check
-from .errors import GrammarError, LimitError
-from .geometry import DEG
-from .grammar.model import COND_EQ0, COND_GT0, Case, Grammar, Pop, Push, Symbol, Turtle
-from .model import Drawing
+from lsys_core.cancel import CancelToken, check
+from lsys_core.derive.model import Drawing
+from lsys_core.errors import GrammarError, LimitError
+from lsys_core.geometry.transforms import DEG
+from lsys_core.grammar.model import COND_EQ0, COND_GT0, Case, Grammar, Pop, Push, Symbol, Turtle
 
 __all__ = ["DEFAULT_LIMIT", "Randomize", "derive"]
 

@@ -21,8 +21,8 @@ from dataclasses import replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .clustering import mean_shift
-from .model import Instancing
+from lsys_core.hierarchy.clustering import mean_shift
+from lsys_core.instancing.model import Instancing
 
 __all__ = ["estimate_pivots", "recenter"]
 
@@ -112,7 +112,7 @@ def recenter(inst: Instancing, offsets: np.ndarray) -> Instancing:
     """Move terminal origins by ``offsets`` (local coordinates): shapes shift, poses follow."""
     if not np.any(offsets):
         return inst
-    from .svg.pathdata import cubics_from_d, d_from_cubics
+    from lsys_core.geometry.paths import cubics_from_d, d_from_cubics
 
     terminals = list(inst.terminals)
     for g, o in enumerate(offsets):

@@ -1,4 +1,4 @@
-"""Raster rendering of a :class:`~lsys_core.model.Drawing` with skia-python (CPU).
+"""Raster rendering of a :class:`~lsys_core.derive.model.Drawing` with skia-python (CPU).
 
 :class:`Renderer` keeps one skia surface wrapped around a numpy array, and one
 skia path and paint per terminal, so repeated redraws (the editor's canvas)
@@ -35,10 +35,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import LsysError
-from .io import write_atomic
-from .model import Drawing
-from .render_paths import (
+from lsys_core.derive.model import Drawing
+from lsys_core.errors import LsysError
+from lsys_core.io import write_atomic
+from lsys_core.render.paths import (
     _BUCKETS_PER_OCTAVE,
     _disjoint_runs,
     _flatten,
@@ -94,7 +94,7 @@ def default_view(drawing: Drawing) -> tuple[float, float, float, float]:
     """Return the drawing's viewBox, or its bounds with a small margin, or a unit square."""
     if drawing.viewbox is not None:
         return drawing.viewbox
-    from .svg.export import MARGIN, drawing_bounds
+    from lsys_core.render.svg import MARGIN, drawing_bounds
 
     bounds = drawing_bounds(drawing)
     if bounds is None:

@@ -10,16 +10,16 @@ from dataclasses import replace
 
 import numpy as np
 
-from .errors import GrammarError
-from .grammar.model import Count, Grammar, Module, Symbol, Terminal
-from .grammar.validate import validate
+from lsys_core.errors import GrammarError
+from lsys_core.grammar.model import Count, Grammar, Module, Rule, Symbol, Terminal
+from lsys_core.grammar.validate import validate
 
-__all__ = ["replace_terminal", "replace_with_terminal", "set_axiom_count"]
+__all__ = ["drop_unreachable", "replace_terminal", "replace_with_terminal", "set_axiom_count"]
 
 
 def _shape_circle(path: str) -> tuple[complex, float]:
     """Centre and radius of the control polygon of SVG path data."""
-    from .svg.pathdata import cubics_from_d
+    from lsys_core.geometry.paths import cubics_from_d
 
     cubics, _, _ = cubics_from_d(path)
     if cubics.size == 0:
@@ -47,7 +47,7 @@ def replace_terminal(
         Centre the new shape where the old one was centred in the local frame and scale it
         to the old one's size, so a shape picked anywhere in a document drops into place.
     """
-    from .svg.pathdata import cubics_from_d, d_from_cubics
+    from lsys_core.geometry.paths import cubics_from_d, d_from_cubics
 
     old = grammar.terminal(name)
     if old is None:
@@ -87,7 +87,6 @@ def replace_with_terminal(grammar: Grammar, nonterminal: str, terminal: str) -> 
         if r.name != nonterminal
     )
     g = replace(grammar, rules=rules, axiom=_swap(grammar.axiom, nonterminal, terminal))
-    from .postprocess import drop_unreachable
 
     g = drop_unreachable(g)
     validate(g)
@@ -104,3 +103,23 @@ def set_axiom_count(grammar: Grammar, m: int) -> Grammar:
             axiom[i] = Symbol(mod.name, Count(int(m)))
             return replace(grammar, axiom=tuple(axiom))
     raise GrammarError("the axiom has no symbol with a counter m")
+
+
+def drop_unreachable(g: Grammar) -> Grammar:
+    """Return ``g`` without the rules that the axiom can never reach."""
+    reachable = _reachable(list(g.rules), g.axiom)
+    return replace(g, rules=tuple(r for r in g.rules if r.name in reachable))
+
+
+def _reachable(rules: list[Rule], axiom: tuple[Module, ...]) -> set[str]:
+    by_name = {r.name: r for r in rules}
+    todo = [m.name for m in axiom if isinstance(m, Symbol)]
+    seen: set[str] = set()
+    while todo:
+        n = todo.pop()
+        if n in seen:
+            continue
+        seen.add(n)
+        for c in by_name[n].cases if n in by_name else ():
+            todo.extend(m.name for m in c.body if isinstance(m, Symbol))
+    return seen

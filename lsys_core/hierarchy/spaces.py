@@ -26,7 +26,7 @@ class PairSpace:
     src, dst : ndarray of int
         Back-links: the pair's first and second node.
     A, B : ndarray of complex
-        Relative frame of ``dst`` seen from ``src`` (:func:`lsys_core.geometry.relative`).
+        Relative frame of ``dst`` seen from ``src`` (:func:`lsys_core.geometry.transforms.relative`).
     alpha, d, s, beta : ndarray of float
         The paper's ``+(alpha) f(d) *(s) +(beta)`` (degrees).
     dist : ndarray of float
@@ -66,7 +66,7 @@ def pair_space(
     k : int
         Neighbours per node (both directions of every pair are kept).
     """
-    from .geometry import t4_from_rel
+    from lsys_core.geometry.transforms import t4_from_rel
 
     n = a.size
     if n < 2:

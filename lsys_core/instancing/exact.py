@@ -1,18 +1,18 @@
 """Recognise exact copies of a representative from their control points.
 
-Helpers of :mod:`lsys_core.similarity`.  Copies made by ``<use>``, ``transform`` or
+Helpers of :mod:`lsys_core.instancing.similarity`.  Copies made by ``<use>``, ``transform`` or
 baking keep the cubic structure of the original: the same segments, perhaps from another
 start point of a closed outline or in the reverse direction.  For those the similarity
 follows in closed form from a complex least-squares fit of the control points, which is
 both faster and more exact than sampling; everything else goes through the vote and ICP
-of :mod:`lsys_core.similarity_match`.
+of :mod:`lsys_core.instancing.match`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .model import Element
+from lsys_core.svg.model import Element
 
 __all__ = ["EXACT_TOL", "fit_exact", "structure_key", "variants"]
 

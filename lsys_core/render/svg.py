@@ -1,4 +1,4 @@
-"""Write a :class:`~lsys_core.model.Drawing` as SVG.
+"""Write a :class:`~lsys_core.derive.model.Drawing` as SVG.
 
 Every terminal instance becomes one ``<path>`` element — the terminal's path
 data, its pose as ``transform="matrix(a b c d e f)"`` and its style — so a
@@ -14,10 +14,10 @@ from xml.sax.saxutils import escape
 
 import numpy as np
 
-from ..errors import LsysError
-from ..io import write_atomic
-from ..model import Drawing
-from .pathdata import cubics_from_d
+from lsys_core.derive.model import Drawing
+from lsys_core.errors import LsysError
+from lsys_core.geometry.paths import cubics_from_d
+from lsys_core.io import write_atomic
 
 __all__ = ["check_finite", "drawing_bounds", "drawing_to_svg", "export_svg", "terminal_points"]
 

@@ -9,9 +9,10 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from .grammar.model import Case, Grammar, Module, Pop, Push, Rule, Symbol
+from lsys_core.grammar.edit import drop_unreachable
+from lsys_core.grammar.model import Case, Grammar, Module, Pop, Push, Rule, Symbol
 
-__all__ = ["drop_unreachable", "simplify"]
+__all__ = ["simplify"]
 
 
 def _uses(g: Grammar) -> dict[str, int]:
@@ -94,23 +95,3 @@ def simplify(g: Grammar) -> Grammar:
             changed = True
             break
     return drop_unreachable(replace(g, rules=tuple(rules)))
-
-
-def drop_unreachable(g: Grammar) -> Grammar:
-    """Return ``g`` without the rules that the axiom can never reach."""
-    reachable = _reachable(list(g.rules), g.axiom)
-    return replace(g, rules=tuple(r for r in g.rules if r.name in reachable))
-
-
-def _reachable(rules: list[Rule], axiom: tuple[Module, ...]) -> set[str]:
-    by_name = {r.name: r for r in rules}
-    todo = [m.name for m in axiom if isinstance(m, Symbol)]
-    seen: set[str] = set()
-    while todo:
-        n = todo.pop()
-        if n in seen:
-            continue
-        seen.add(n)
-        for c in by_name[n].cases if n in by_name else ():
-            todo.extend(m.name for m in c.body if isinstance(m, Symbol))
-    return seen

@@ -1,4 +1,4 @@
-"""Paths and paints for :mod:`lsys_core.render`: styles, terminal outlines, batched geometry.
+"""Paths and paints for :mod:`lsys_core.render.raster`: styles, terminal outlines, batched geometry.
 
 The helpers turn a terminal's SVG path data and CSS style into arrays and skia objects,
 flatten and tile outlines for draft mode, and find the runs of non-overlapping instances
@@ -14,7 +14,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .errors import LsysError
+from lsys_core.errors import LsysError
 
 #: In draft mode, a curve needing more lines than this is left to skia's own subdivision.
 DRAFT_MAX_LINES = 8
@@ -159,7 +159,7 @@ _EMPTY = _Geometry(
 
 def _geometry(d: str) -> _Geometry:
     """Turn path data into skia points and verbs (lines where control points sit at thirds)."""
-    from .svg.pathdata import _collinear_thirds, cubics_from_d
+    from lsys_core.geometry.paths import _collinear_thirds, cubics_from_d
 
     try:
         cubics, subpaths, closed = cubics_from_d(d) if d.strip() else (np.zeros((0, 4), complex), None, ())

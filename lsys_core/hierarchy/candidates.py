@@ -1,6 +1,6 @@
 """Cluster analysis (paper §5.3): candidate rules from the clusters of one level.
 
-Pairs of live nodes (:mod:`lsys_core.transforms`) are clustered by mean shift in each
+Pairs of live nodes (:mod:`lsys_core.hierarchy.spaces`) are clustered by mean shift in each
 space of a pair of symbols.  Clusters *C* of (nearly) equal transforms give sequences
 (chains of pairs, r1/r2) and pairs of different symbols; two clusters of one space that
 share their first elements give branchings (full binary trees, r3/r4); clusters *D* in
@@ -14,9 +14,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .clustering import mean_shift
-from .geometry import wrap_deg
-from .transforms import PairSpace
+from lsys_core.geometry.transforms import wrap_deg
+from lsys_core.hierarchy.clustering import mean_shift
+from lsys_core.hierarchy.spaces import PairSpace
 
 __all__ = ["NEAR_BAND", "Candidate", "find_candidates", "mean_rel"]
 

@@ -20,13 +20,14 @@ from collections import deque
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .cancel import CancelToken, Progress, check, report
-from .errors import InferenceError
-from .grammar.model import Terminal
-from .model import Element, Instancing, Scene
-from .similarity_exact import EXACT_TOL, fit_exact, structure_key, variants
-from .similarity_match import PERFECT, Batch, Reference, match_batch
-from .similarity_sampling import Samples, arc_fractions, element_features, sample_elements
+from lsys_core.cancel import CancelToken, Progress, check, report
+from lsys_core.errors import InferenceError
+from lsys_core.grammar.model import Terminal
+from lsys_core.instancing.exact import EXACT_TOL, fit_exact, structure_key, variants
+from lsys_core.instancing.match import PERFECT, Batch, Reference, match_batch
+from lsys_core.instancing.model import Instancing
+from lsys_core.instancing.sampling import Samples, arc_fractions, element_features, sample_elements
+from lsys_core.svg.model import Element, Scene
 
 __all__ = ["detect_similarity", "symmetry_order", "terminal_name", "terminal_similarity"]
 
@@ -45,7 +46,7 @@ def terminal_name(index: int) -> str:
 
 def _path_data(element: Element, origin: complex) -> str:
     """Return the element's path data translated by ``-origin``."""
-    from .svg.pathdata import d_from_cubics
+    from lsys_core.geometry.paths import d_from_cubics
 
     cubics = np.asarray(element.cubics, dtype=complex).reshape(-1, 4) - origin
     return d_from_cubics(cubics, np.asarray(element.subpaths), tuple(element.closed))
@@ -403,7 +404,7 @@ def terminal_similarity(
     ndarray of float, shape (k, k)
         Symmetric, 1 on the diagonal; 0 between a drawable shape and an empty one.
     """
-    from .svg.pathdata import cubics_from_d
+    from lsys_core.geometry.paths import cubics_from_d
 
     k = len(terminals)
     elements = tuple(Element(*cubics_from_d(t.path)) for t in terminals)

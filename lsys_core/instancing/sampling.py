@@ -1,6 +1,6 @@
 """Sample many elements at once by arc length, with normals, curvature and shape descriptors.
 
-Helpers of :mod:`lsys_core.similarity` (§4.1 of the paper, steps 1–4).  All elements
+Helpers of :mod:`lsys_core.instancing.similarity` (§4.1 of the paper, steps 1–4).  All elements
 are stacked into one array of cubic segments so that sampling 10,000 elements is a
 handful of numpy operations.  Points are complex numbers ``x + iy``.
 """
@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import Element
+from lsys_core.svg.model import Element
 
 __all__ = ["Samples", "arc_fractions", "bezier", "element_features", "sample_elements"]
 

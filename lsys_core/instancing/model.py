@@ -1,0 +1,39 @@
+"""The value similarity detection and inverse instancing produce (§4.1–4.2)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from lsys_core.grammar.model import Terminal
+
+__all__ = ["Instancing"]
+
+
+@dataclass(frozen=True, eq=False)
+class Instancing:
+    """Result of similarity detection and inverse instancing (§4.1–4.2).
+
+    Attributes
+    ----------
+    group : ndarray of int, shape (n,)
+        Similarity group (terminal index) of every element.
+    a, b : ndarray of complex, shape (n,)
+        Pose of every element: the element is its group's representative shape
+        (in the terminal's local frame) mapped by ``z -> a*z + b``.
+    terminals : tuple of Terminal
+        One terminal per group: the representative's shape in its local frame.
+    symmetry : ndarray of int, shape (groups,)
+        Rotational symmetry order of each terminal's shape (1: none, k: k-fold,
+        0: continuous, e.g. a circle), so inference may choose among equivalent poses.
+    mirrored_of : ndarray of int, shape (groups,)
+        For a terminal that is the mirror image of another, that group's index; else -1.
+    """
+
+    group: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    terminals: tuple[Terminal, ...]
+    symmetry: np.ndarray
+    mirrored_of: np.ndarray
