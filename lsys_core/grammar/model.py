@@ -36,6 +36,7 @@ __all__ = [
     "Symbol",
     "Terminal",
     "Turtle",
+    "Verbatim",
 ]
 
 COND_GT0 = "m > 0"
@@ -142,6 +143,21 @@ class Terminal:
 
 
 @dataclass(frozen=True)
+class Verbatim:
+    """Input content kept as is, not turned into rules (``<text>``, ``<image>``, unknown elements).
+
+    ``order`` is its place in the document's paint order, numbered like the input's drawable
+    elements (see :attr:`lsys_core.svg.model.Element.order`); ``xml`` its self-contained SVG
+    markup in document coordinates (ancestor transforms and inherited styles applied, e.g. by a
+    wrapping ``<g>``); ``what`` a short description for reports ("<text> 'Hello'").
+    """
+
+    order: int
+    xml: str
+    what: str = ""
+
+
+@dataclass(frozen=True)
 class Grammar:
     """A complete L-system: terminals, rules, axiom and the SVG canvas it draws on.
 
@@ -155,6 +171,11 @@ class Grammar:
     viewbox: tuple[float, float, float, float] | None = None
     size: tuple[str, str] | None = None
     comments: tuple[str, ...] = field(default=(), compare=False)
+    #: SVG markup the terminals' and instances' styles refer to by ``url(#id)`` (gradients,
+    #: patterns, clip paths, masks, filters, markers): written into the output's ``<defs>``.
+    defs: str = ""
+    #: Content carried through verbatim, drawn at its place in the paint order.
+    verbatim: tuple[Verbatim, ...] = ()
 
     def terminal(self, name: str) -> Terminal | None:
         """Return the terminal called ``name``, or None."""

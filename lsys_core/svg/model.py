@@ -11,7 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Element", "Scene"]
+from lsys_core.grammar.model import Verbatim
+
+__all__ = ["Element", "Scene", "Verbatim"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -30,6 +32,9 @@ class Element:
         Resolved CSS declarations (``fill:#fff;stroke:none;...``) as the element is drawn.
     source : str
         A short description of where it came from (tag and id), for messages.
+    order : int
+        Place in the document's paint order (shared numbering with :class:`Verbatim` content);
+        -1: not given (the element's index in :attr:`Scene.elements` is its order).
     """
 
     cubics: np.ndarray
@@ -37,6 +42,7 @@ class Element:
     closed: tuple[bool, ...]
     style: str = ""
     source: str = ""
+    order: int = -1
 
 
 @dataclass(frozen=True, eq=False)
@@ -44,7 +50,9 @@ class Scene:
     """An imported SVG: its elements and canvas.
 
     ``viewbox`` is ``(x, y, width, height)``; ``size`` the ``width``/``height`` attributes;
-    ``warnings`` say what was skipped and why; ``source_bytes`` is the file's size.
+    ``warnings`` say what was skipped and why; ``source_bytes`` is the file's size; ``defs`` the
+    markup of what element styles refer to by ``url(#id)`` (paint servers, clip paths, masks,
+    filters); ``verbatim`` the content kept as is, with its place in the paint order.
     """
 
     elements: tuple[Element, ...]
@@ -52,3 +60,5 @@ class Scene:
     size: tuple[str, str] | None = None
     warnings: tuple[str, ...] = ()
     source_bytes: int = 0
+    defs: str = ""
+    verbatim: tuple[Verbatim, ...] = ()
