@@ -22,6 +22,7 @@ lint: $(STAMP)
 	$(BIN)/ruff check lsys_core app tests
 	$(BIN)/ruff format --check lsys_core app tests
 	$(BIN)/lint-imports
+	$(BIN)/mypy
 
 test: $(STAMP) lint
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q

@@ -18,7 +18,7 @@ from lsys_core.errors import InferenceError
 from lsys_core.grammar.model import Grammar
 from lsys_core.hierarchy.pivots import estimate_pivots, recenter
 from lsys_core.hierarchy.postprocess import simplify
-from lsys_core.hierarchy.rules import Tolerance, Weights, build_hierarchy
+from lsys_core.hierarchy.rules import Hierarchy, Tolerance, Weights, build_hierarchy
 from lsys_core.instancing.fidelity import split_unfaithful
 from lsys_core.instancing.model import Instancing
 from lsys_core.instancing.orientation import unwrap_symmetric
@@ -140,6 +140,7 @@ def _factors(settings: InferenceSettings, symmetrizing: bool, n: int) -> list[fl
 
     Large scenes try fewer relaxed factors: each try is a whole rule generation.
     """
+    steps: tuple[float, ...]
     if symmetrizing:
         steps = (1.0, 2.0)
     elif n <= LARGE_SCENE:
@@ -241,8 +242,8 @@ def infer(
     weights = Weights(settings.wn, settings.wh, settings.wphi, settings.wl)
     diag = _diagonal(center, radius)
     shape_sim = _shape_similarity(inst, cancel)
-    best = None
-    first_count: int | None = None
+    best: tuple[Grammar, Hierarchy, float] | None = None
+    first_count: int | None = None  # production count of the first try, which is always kept
     for factor in _factors(settings, symmetrizing, len(scene.elements)):
         check(cancel)
         hier = build_hierarchy(
@@ -268,7 +269,7 @@ def infer(
         )
         stages["postprocess"] = stages.get("postprocess", 0.0) + time.perf_counter() - t
         count = description_size(grammar)
-        if best is None:
+        if first_count is None:
             ok = True
         elif symmetrizing:
             ok = error <= SYMMETRIZE_ERROR
@@ -276,10 +277,11 @@ def infer(
             ok = error <= INFER_ERROR or (error <= JITTER_ERROR and count <= JITTER_GAIN * first_count)
         if ok and (best is None or (count, error) < (description_size(best[0]), best[2])):
             best = (grammar, hier, error)
-        if best is not None and first_count is None:
+        if first_count is None:
             first_count = count
         if hier.closed and not symmetrizing:
             break  # every element is explained by repetitions: no need to relax
+    assert best is not None  # _factors is never empty and the first try is always kept
     grammar, hier, error = best
     stages["reproduction_error"] = error
     report(progress, "done", 1.0)

@@ -20,7 +20,7 @@ path data and style, in their own local frame), rules and the axiom.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Final, Literal
 
 __all__ = [
     "COND_EQ0",
@@ -39,9 +39,11 @@ __all__ = [
     "Verbatim",
 ]
 
-COND_GT0 = "m > 0"
-COND_EQ0 = "m == 0"
-Condition = Literal["m > 0", "m == 0"] | None
+COND_GT0: Final = "m > 0"
+COND_EQ0: Final = "m == 0"
+#: The condition of a case of a parametric rule.
+CaseCondition = Literal["m > 0", "m == 0"]
+Condition = CaseCondition | None
 TurtleOp = Literal["f", "+", "-", "*"]
 
 

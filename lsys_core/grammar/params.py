@@ -126,18 +126,21 @@ def set_param(g: Grammar, key: str, value: float) -> Grammar:
         For an unknown key (listing a few valid ones) or a value out of range.
     """
     owner, ci, index, fld = _resolve(g, key)
-    body = g.axiom if owner == "axiom" else g.rule(owner).cases[ci].body
+    body = _body(g, owner, ci)
     mod = body[index]
     x = _finite(key, value)
-    if fld == "m":
+    # _resolve returns field m only for a constant counter argument, v and dv only for a turtle value
+    if isinstance(mod, Symbol) and mod.arg is not None:
         if not x.is_integer() or not 0 <= x <= COUNT_LIMIT:
             raise GrammarError(f"parameter {key}: a count must be a whole number >= 0, got {value!r}")
         new: Module = replace(mod, arg=replace(mod.arg, k0=int(x)))
-    else:
+    elif isinstance(mod, Turtle):
         lin = Linear(x, mod.value.cd) if fld == "v" else Linear(mod.value.c0, x)
         if mod.op == "*" and lin.cd == 0 and lin.c0 <= 0:
             raise GrammarError(f"parameter {key}: a scale must be positive, got {value!r}")
         new = replace(mod, value=lin)
+    else:  # pragma: no cover - _resolve never returns another module
+        raise GrammarError(f"unknown parameter '{key}'")
     body = (*body[:index], new, *body[index + 1 :])
     if owner == "axiom":
         return replace(g, axiom=body)
@@ -157,7 +160,15 @@ def set_params(g: Grammar, values: Mapping[str, float]) -> Grammar:
     return g
 
 
-def _finite(key: str, value: object) -> float:
+def _body(g: Grammar, owner: str, ci: int) -> tuple[Module, ...]:
+    """Return body ``ci`` of rule ``owner`` (the axiom for ``axiom``); empty if there is none."""
+    if owner == "axiom":
+        return g.axiom if ci == 0 else ()
+    rule = g.rule(owner)
+    return rule.cases[ci].body if rule is not None and ci < len(rule.cases) else ()
+
+
+def _finite(key: str, value: float | str) -> float:
     """Return ``value`` as a finite float or raise :class:`GrammarError`."""
     try:
         x = float(value)
@@ -179,11 +190,13 @@ def _resolve(g: Grammar, key: str) -> tuple[str, int, int, str]:
     if len(parts) == 4 and parts[1].isdigit() and parts[2].isdigit():
         owner, ci, index, fld = parts[0], int(parts[1]), int(parts[2]), parts[3]
         rule = g.rule(owner)
-        cases = [g.axiom] if owner == "axiom" else [c.body for c in rule.cases] if rule else []
-        mod = cases[ci][index] if ci < len(cases) and index < len(cases[ci]) else None
-        if isinstance(mod, Turtle) and (fld == "v" or (fld == "dv" and rule is not None and rule.parametric)):
+        body = _body(g, owner, ci)
+        target = body[index] if index < len(body) else None
+        if isinstance(target, Turtle) and (
+            fld == "v" or (fld == "dv" and rule is not None and rule.parametric)
+        ):
             return owner, ci, index, fld
-        if isinstance(mod, Symbol) and fld == "m" and mod.arg is not None and mod.arg.k1 == 0:
+        if isinstance(target, Symbol) and fld == "m" and target.arg is not None and target.arg.k1 == 0:
             return owner, ci, index, fld
     valid = [p.key for p in list_params(g)]
     some = ", ".join(valid[:6]) + (", ..." if len(valid) > 6 else "") if valid else "none"

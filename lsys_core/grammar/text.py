@@ -26,6 +26,7 @@ from lsys_core.grammar.model import (
     COND_EQ0,
     COND_GT0,
     Case,
+    CaseCondition,
     Count,
     Grammar,
     Linear,
@@ -36,6 +37,7 @@ from lsys_core.grammar.model import (
     Symbol,
     Terminal,
     Turtle,
+    TurtleOp,
 )
 from lsys_core.grammar.validate import KEYWORDS, RESERVED, Problem, count_text, find_problems, path_problem
 
@@ -64,6 +66,7 @@ _ESCAPES = {"\\": "\\", '"': '"', "n": "\n", "r": "\r", "t": "\t"}
 _QUOTING = str.maketrans({v: "\\" + k for k, v in _ESCAPES.items()})
 _NON_FINITE = frozenset({"nan", "inf", "infinity"})
 _UNICODE_OPS = {"−": "-", "∗": "*"}  # the paper's minus and asterisk, as pasted from a PDF
+_TURTLE_OPS: dict[str, TurtleOp] = {"f": "f", "+": "+", "-": "-", "*": "*"}
 
 
 class _Tok(NamedTuple):
@@ -115,6 +118,7 @@ def _tokenize(text: str) -> tuple[list[list[_Tok]], list[tuple[int, str]], tuple
                 raise _fail("unterminated string: add the closing '\"'", (line, col))
             raise _fail(f"unexpected character {text[pos]!r}", (line, col))
         kind, raw = mt.lastgroup, mt.group()
+        assert kind is not None  # every alternative of _TOKEN is a named group
         pos = mt.end()
         if kind == "nl":
             if current:
@@ -269,7 +273,8 @@ class _Line:
             seen.add(opt)
             self.st.places[("canvas", opt)] = self.toks[self.i - 1].pos
             if opt == "viewbox":
-                self.st.viewbox = tuple(self.signed_number() for _ in range(4))
+                x, y, w, h = (self.signed_number() for _ in range(4))
+                self.st.viewbox = (x, y, w, h)
             else:
                 self.st.size = (self.string("the width"), self.string("the height"))
         if not seen:
@@ -339,7 +344,7 @@ class _Line:
         self.st.places[("rule", tok.text, ci, None, False)] = tok.pos
         acc.cases.append(Case(cond, self.body(tok.text, ci, parametric)))
 
-    def condition(self) -> str:
+    def condition(self) -> CaseCondition:
         """Read ``m > 0`` or ``m == 0``."""
         toks = []
         for ok in (lambda t: t.text == "m", lambda t: t.text in (">", "=="), lambda t: t.text == "0"):
@@ -383,7 +388,7 @@ class _Line:
                 self.take()
                 self.expect("(", f"'(' after '{tok.text}'")
                 self.st.places[(where, owner, ci, len(mods), True)] = self.peek().pos
-                mods.append(Turtle(tok.text, self.linear(no_m)))
+                mods.append(Turtle(_TURTLE_OPS[tok.text], self.linear(no_m)))
                 self.expect(")")
             elif tok.kind == "name" and tok.text == "m":
                 raise _fail("m is the counter: use it in an argument, e.g. P(m-1) or f(2*m)", tok)

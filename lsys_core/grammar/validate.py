@@ -339,16 +339,17 @@ def _termination_problems(g: Grammar) -> list[Problem]:
     out = []
     zero_calls = []
     for on_cycle, c in zip(cyclic(scc(edges), edges), calls, strict=True):
-        _, v, r, ci, mi, mod = c
+        _, _, r, ci, mi, mod = c
         if not on_cycle:
             continue
-        call = mod.name + (f"({count_text(mod.arg)})" if mod.arg is not None else "")
-        if not g.rules[v].parametric:
+        arg = mod.arg
+        call = mod.name + (f"({count_text(arg)})" if arg is not None else "")
+        if arg is None:  # well-formed: a call passes a counter exactly when its rule is parametric
             why = f"the call {call} closes a cycle that has no counter to stop it"
-        elif mod.arg.k1 != 1 or mod.arg.k0 > 0:
+        elif arg.k1 != 1 or arg.k0 > 0:
             why = f"the call {call} does not decrease m (write {mod.name}(m-1))"
         else:
-            if mod.arg.k0 == 0:
+            if arg.k0 == 0:
                 zero_calls.append(c)
             continue
         out.append(Problem(f"rule {r.name} never terminates: {why}", "rule", r.name, ci, mi))
@@ -403,8 +404,9 @@ def count_text(a: Count) -> str:
 
 def _finite(x: object) -> bool:
     """Tell whether ``x`` is a finite real number."""
-    real = isinstance(x, int | float | np.integer | np.floating) and not isinstance(x, bool)
-    return real and math.isfinite(x)
+    if isinstance(x, bool) or not isinstance(x, int | float | np.integer | np.floating):
+        return False
+    return math.isfinite(x)
 
 
 def _is_int(x: object) -> bool:

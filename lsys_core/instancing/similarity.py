@@ -363,15 +363,15 @@ def detect_similarity(
         report(progress, _STAGE, 0.1 + 0.85 * float(np.count_nonzero(group >= 0)) / n)
     symmetry = np.ones(len(rep_index), dtype=int)
     terminals = []
-    for g, (r, rep) in enumerate(zip(rep_index, reps, strict=True)):
-        origin = rep.origin if rep is not None else complex(b[r])
+    for g, (r, rep_g) in enumerate(zip(rep_index, reps, strict=True)):
+        origin = rep_g.origin if rep_g is not None else complex(b[r])
         name = terminal_name(g)
         other = terminal_name(mirror_of[g]) if mirror_of[g] >= 0 else None
         terminals.append(Terminal(name, _path_data(elements[r], origin), elements[r].style, other))
-        if rep is None:
+        if rep_g is None:
             symmetry[g] = 0
             continue
-        order, period = symmetry_order(rep.ref.dense, rep.ref.dense_normals)
+        order, period = symmetry_order(rep_g.ref.dense, rep_g.ref.dense_normals)
         symmetry[g] = order
         sel = group == g
         a[sel] = _canonical(a[sel], period)

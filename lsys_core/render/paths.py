@@ -162,7 +162,9 @@ def _geometry(d: str) -> _Geometry:
     from lsys_core.geometry.paths import _collinear_thirds, cubics_from_d
 
     try:
-        cubics, subpaths, closed = cubics_from_d(d) if d.strip() else (np.zeros((0, 4), complex), None, ())
+        cubics, subpaths, closed = (
+            cubics_from_d(d) if d.strip() else (np.zeros((0, 4), complex), np.zeros(0, int), ())
+        )
     except LsysError:
         return _EMPTY
     k = len(cubics)

@@ -162,8 +162,7 @@ class Renderer:
 
     def __init__(self, width: int, height: int) -> None:
         self._cache: dict[tuple[str, str], _Terminal] = {}
-        self._surface = None
-        self.resize(width, height)
+        self.resize(width, height)  # sets the pixels, the skia surface and its canvas
 
     @property
     def size(self) -> tuple[int, int]:
@@ -537,21 +536,21 @@ def _png_size(drawing: Drawing, width: int | None, height: int | None) -> tuple[
     """Choose the PNG size: as given, else from the drawing's canvas with its aspect ratio."""
     _, _, vw, vh = default_view(drawing)
     aspect = vw / vh if vw > 0 and vh > 0 else 1.0
-    if width is None and height is None:
-        size = drawing.size
-        w = _number(size[0], vw) if size else vw
-        h = _number(size[1], vh) if size else vh
-        if not (w > 0 and h > 0) or (size and ("%" in size[0] or "%" in size[1])):
-            w, h = vw, vh
-        w, h = max(1, round(w)), max(1, round(h))
-    elif width is None:
+    if width is not None and height is not None:
+        w, h = int(width), int(height)
+    elif height is not None:
         h = int(height)
         w = max(1, round(h * aspect))
-    elif height is None:
+    elif width is not None:
         w = int(width)
         h = max(1, round(w / aspect))
     else:
-        w, h = int(width), int(height)
+        size = drawing.size
+        fw = _number(size[0], vw) if size else vw
+        fh = _number(size[1], vh) if size else vh
+        if not (fw > 0 and fh > 0) or (size and ("%" in size[0] or "%" in size[1])):
+            fw, fh = vw, vh
+        w, h = max(1, round(fw)), max(1, round(fh))
     w, h = min(w, MAX_SIDE), min(h, MAX_SIDE)
     if w * h > MAX_PNG_PIXELS:
         shrink = math.sqrt(MAX_PNG_PIXELS / (w * h))

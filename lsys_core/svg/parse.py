@@ -16,10 +16,12 @@ import io
 import math
 import os
 import re
+import xml.etree.ElementTree as ET
 import zlib
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -33,6 +35,9 @@ from lsys_core.geometry.paths import (
     raw_from_segments,
 )
 from lsys_core.svg.model import Element, Scene
+
+if TYPE_CHECKING:
+    from svgelements import Shape
 
 __all__ = ["DEFAULT_MAX_BYTES", "DEFAULT_MAX_DEPTH", "DEFAULT_MAX_ELEMENTS", "load_svg", "parse_svg"]
 
@@ -229,8 +234,6 @@ def _check_bytes(data: bytes, name: str) -> None:
 
 def _parse_xml(source: str | bytes, name: str):
     """Parse with defusedxml: no entities, no external references."""
-    import xml.etree.ElementTree as ET
-
     import defusedxml
     import defusedxml.ElementTree as DET
 
@@ -261,8 +264,6 @@ def _local(tag) -> str | None:
 
 def _prepare(source: str | bytes, max_elements: int, max_depth: int, name: str) -> _Prepared:
     """Check the XML tree and re-serialise it for svgelements."""
-    import xml.etree.ElementTree as ET
-
     raw = source if isinstance(source, bytes) else source.encode("utf-8", "replace")
     _check_bytes(raw, name)
     root = _parse_xml(source, name)  # rejects entities (billion laughs, XXE) first
@@ -313,8 +314,8 @@ def _prepare(source: str | bytes, max_elements: int, max_depth: int, name: str) 
             names.append(f"{tag}#{el_id}" if el_id else f"{tag}[{i}]")
             if tag == "path":
                 # Parse path data here; svgelements then only resolves the transform.
-                raw, reason = _path_raw(el.get("d"))
-                paths[key] = raw
+                path_raw, reason = _path_raw(el.get("d"))
+                paths[key] = path_raw
                 el.set("d", "")
                 if reason is not None:
                     reasons[key] = reason
@@ -433,9 +434,9 @@ def _snippet(text: str, n: int = 40) -> str:
     return repr(text if len(text) <= n else text[: n - 3] + "...")
 
 
-def _remove_children(pairs: list) -> None:
+def _remove_children(pairs: list[tuple[ET.Element, ET.Element]]) -> None:
     """Remove ``(parent, child)`` pairs, rebuilding each parent's children once (linear time)."""
-    by_parent: dict[int, tuple[object, set[int]]] = {}
+    by_parent: dict[int, tuple[ET.Element, set[int]]] = {}
     for parent, el in pairs:
         by_parent.setdefault(id(parent), (parent, set()))[1].add(id(el))
     for parent, gone in by_parent.values():
@@ -645,8 +646,8 @@ def _diagnose(prepared: _Prepared, name: str, exc: Exception) -> SvgError:
         except (*SVGELEMENTS_ERRORS, RecursionError):
             return SvgError(f"cannot read SVG {name}: invalid transform {_snippet(text)} on {where}")
     detail = str(exc).strip() or type(exc).__name__
-    where = _failing_element(exc, prepared.names)
-    at = f" on {where}" if where else ""
+    culprit = _failing_element(exc, prepared.names)
+    at = f" on {culprit}" if culprit else ""
     return SvgError(f"cannot read SVG {name}: invalid attribute value{at} ({_snippet(detail, 80)[1:-1]})")
 
 
@@ -697,7 +698,7 @@ def _apply(cubics: np.ndarray, mats: np.ndarray) -> np.ndarray:
         return (a * x + c * y + e) + 1j * (b * x + d * y + f)
 
 
-def _shapes(doc) -> Iterator[tuple[object, tuple[str, ...], float]]:
+def _shapes(doc) -> Iterator[tuple[Shape, tuple[str, ...], float]]:
     """Yield ``(shape, use_chain, opacity)`` for every shape in document order.
 
     ``use_chain`` holds the source indices of the ``<use>`` elements the shape is
