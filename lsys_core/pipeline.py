@@ -94,7 +94,6 @@ class InferenceResult:
     instancing: Instancing
     stages: dict[str, float]
     seconds: float
-    element_rule: np.ndarray
     log: tuple[str, ...] = field(default=())
 
 
@@ -285,9 +284,7 @@ def infer(
     grammar, hier, error = best
     stages["reproduction_error"] = error
     report(progress, "done", 1.0)
-    return InferenceResult(
-        grammar, inst, stages, time.perf_counter() - t_all, hier.node_rule, tuple(hier.log)
-    )
+    return InferenceResult(grammar, inst, stages, time.perf_counter() - t_all, tuple(hier.log))
 
 
 def symmetrize(

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -37,7 +37,6 @@ class Drawing:
     rule: np.ndarray
     viewbox: tuple[float, float, float, float] | None = None
     size: tuple[str, str] | None = None
-    meta: dict = field(default_factory=dict)
 
     def __len__(self) -> int:
         return int(self.symbol.size)

@@ -54,10 +54,6 @@ class Linear:
     c0: float
     cd: float = 0.0
 
-    def at(self, m):
-        """Evaluate at counter ``m`` (scalar or numpy array)."""
-        return self.c0 + self.cd * m if self.cd else self.c0 + 0 * m
-
 
 @dataclass(frozen=True)
 class Count:
@@ -65,10 +61,6 @@ class Count:
 
     k0: int
     k1: int = 0
-
-    def at(self, m):
-        """Evaluate at counter ``m`` (scalar or numpy array)."""
-        return self.k0 + self.k1 * m
 
 
 @dataclass(frozen=True)
@@ -115,19 +107,6 @@ class Rule:
     name: str
     parametric: bool
     cases: tuple[Case, ...]
-
-    def case_for(self, m: int) -> Case | None:
-        """Return the first case whose condition holds for counter ``m`` (None: no rewrite).
-
-        A parametric symbol with a negative counter is never rewritten (it draws nothing),
-        so a case without a condition applies for ``m >= 0``.
-        """
-        if self.parametric and m < 0:
-            return None
-        for c in self.cases:
-            if c.cond is None or (c.cond == COND_GT0 and m > 0) or (c.cond == COND_EQ0 and m == 0):
-                return c
-        return None
 
 
 @dataclass(frozen=True)
