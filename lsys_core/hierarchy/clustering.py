@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-__all__ = ["mean_shift"]
+__all__ = ["group_indices", "mean_shift"]
 
 
 def _row_keys(cells: np.ndarray) -> np.ndarray:
@@ -133,3 +133,15 @@ def mean_shift(
     remap[rank] = np.arange(rank.size)
     keep = sizes[rank] > 0
     return remap[lab], mode_arr[rank][keep]
+
+
+def group_indices(labels: np.ndarray) -> list[np.ndarray]:
+    """Return the indices of every cluster of ``labels`` (label -1 is noise and left out).
+
+    Clusters come in increasing label order, which :func:`mean_shift` sorts by decreasing size;
+    within a cluster the indices are increasing.
+    """
+    labels = np.asarray(labels)
+    order = np.argsort(labels, kind="stable")
+    cuts = np.flatnonzero(np.diff(labels[order])) + 1
+    return [g for g in np.split(order, cuts) if g.size and labels[g[0]] >= 0]

@@ -21,16 +21,10 @@ from dataclasses import replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from lsys_core.hierarchy.clustering import mean_shift
+from lsys_core.hierarchy.clustering import group_indices, mean_shift
 from lsys_core.instancing.model import Instancing
 
 __all__ = ["estimate_pivots", "recenter"]
-
-
-def _group_indices(labels: np.ndarray) -> list[np.ndarray]:
-    order = np.argsort(labels, kind="stable")
-    cuts = np.flatnonzero(np.diff(labels[order])) + 1
-    return [g for g in np.split(order, cuts) if g.size and labels[g[0]] >= 0]
 
 
 def _pivot_for(a: np.ndarray, b: np.ndarray, size: float, tol_angle: float, rng) -> complex:
@@ -54,7 +48,7 @@ def _pivot_for(a: np.ndarray, b: np.ndarray, size: float, tol_angle: float, rng)
     )
     best, best_support = 0j, 0
     spacing = float(np.median(np.abs(b[dst] - b[src])))
-    for g in _group_indices(lab):
+    for g in group_indices(lab):
         if g.size < 4:
             continue
         db = b[dst[g]] - b[src[g]]

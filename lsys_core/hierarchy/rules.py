@@ -1,48 +1,44 @@
-"""Cluster analysis, importance, rule generation and hierarchy (paper §5.3–§5.6).
+"""Cluster selection, rule generation and the hierarchy of levels (paper §5.4–§5.6).
 
-The scene is a set of *live nodes*: at first the input elements (terminal instances with
-their poses), later non-terminal instances covering groups of elements.  Each level:
+The scene is a set of *live nodes* (:class:`~lsys_core.hierarchy.nodes.Nodes`): at first the
+input elements (terminal instances with their poses), later non-terminal instances covering
+groups of elements.  Each level:
 
 1. pair every node with its nearest neighbours and measure the relative transforms
    (:mod:`lsys_core.hierarchy.spaces`);
-2. cluster them by mean shift (:mod:`lsys_core.hierarchy.clustering`) in each space of a pair of
-   symbols: clusters *C* of (nearly) equal transforms, and clusters *D* in the (d, s)
-   subspace whose α and β change by a constant step along a sequence;
-3. turn clusters into candidate rules: sequences (chains of pairs), branchings (two
-   clusters sharing their first elements: full binary trees) and pairs of different
-   symbols, scored by the importance ``w = wn·n + wh·h + wφ·φ + wl·l``;
-4. apply the most important candidate: emit its rule, replace its nodes by one node of
-   the new non-terminal (pose of the first element), and repeat until one node is left,
-   which becomes the axiom.  When nothing repeats any more, a last rule places the
-   remaining nodes, so no element is ever lost.
+2. cluster them and turn the clusters into candidate rules: sequences, branchings and pairs
+   (:mod:`lsys_core.hierarchy.analysis`), scored by the importance ``w = wn·n + wh·h + wφ·φ + wl·l``;
+3. apply the most important candidate: write its rule (:mod:`lsys_core.hierarchy.emit`),
+   replace its nodes by one node of the new non-terminal (pose of the first element), and
+   repeat until one node is left, which becomes the axiom.  When nothing repeats any more,
+   a last rule places the remaining nodes, so no element is ever lost.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from lsys_core.cancel import CancelToken, Progress, check, report
-from lsys_core.geometry.transforms import t4_from_rel, wrap_deg
-from lsys_core.grammar.model import (
-    COND_EQ0,
-    COND_GT0,
-    Case,
-    Count,
-    Linear,
-    Module,
-    Pop,
-    Push,
-    Rule,
-    Symbol,
-    Turtle,
-)
-from lsys_core.hierarchy.candidates import Candidate, find_candidates
+from lsys_core.grammar.model import Case, Module, Pop, Push, Rule, Symbol
+from lsys_core.hierarchy.analysis import find_candidates
+from lsys_core.hierarchy.candidates import Candidate, SeqCandidate
+from lsys_core.hierarchy.emit import const_t, emit
+from lsys_core.hierarchy.nodes import Nodes
 from lsys_core.hierarchy.spaces import pair_space
+from lsys_core.hierarchy.symbols import SymbolTable
 
 __all__ = ["Hierarchy", "Tolerance", "Weights", "build_hierarchy"]
+
+#: Levels of the hierarchy at most (each level codes at least one repetition).
+MAX_LEVELS = 100
+#: Scenes with more live nodes than this ignore candidates that repeat only twice (see :func:`_chance`).
+CHANCE_SCENE = 100
+#: A best candidate covering less than this share of the nodes is applied together with all
+#: other candidates on disjoint nodes (see :func:`_batch`).
+WEAK_COVER = 0.05
 
 
 @dataclass(frozen=True)
@@ -68,135 +64,50 @@ class Tolerance:
         return Tolerance(self.xy * factor, self.angle * factor, self.scale * factor)
 
 
-@dataclass
-class _Sym:
-    name: str
-    m: int | None
-    terminal: bool
-    size: float
-    family: str  # rule name or terminal name: symbols of one family are alike
-
-
-@dataclass
+@dataclass(frozen=True, eq=False)
 class Hierarchy:
-    """Result of :func:`build_hierarchy`: rules, the axiom and statistics."""
+    """Result of :func:`build_hierarchy`: rules, the axiom and statistics.
 
-    rules: list[Rule]
+    ``node_rule`` gives, for every input element, the index of the first rule that covered
+    it (-1: the axiom); ``closed`` is False when a last rule had to place nodes that no
+    repetition explains.
+    """
+
+    rules: tuple[Rule, ...]
     axiom: tuple[Module, ...]
     levels: int
-    node_rule: np.ndarray  # for every input element: index of the first rule that covered it (-1: axiom)
-    log: list[str] = field(default_factory=list)
-    closed: bool = True  # False when a last rule had to place nodes no repetition explains
+    node_rule: np.ndarray
+    log: tuple[str, ...] = ()
+    closed: bool = True
 
 
-def _t_modules(alpha: Linear, d: Linear, s: Linear, beta: Linear) -> tuple[Module, ...]:
-    """Return ``+(α) f(d) *(s) +(β)`` without identity commands."""
-    out: list[Module] = []
-    if alpha.cd == 0 and beta.cd == 0 and d.cd == 0 and abs(float(wrap_deg(alpha.c0))) > 90.0:
-        # +(α) f(d) … +(β) == +(α-180) f(-d) … +(β+180): keep the turn small.
-        alpha = Linear(float(wrap_deg(alpha.c0 - 180.0)))
-        d = Linear(-d.c0)
-        beta = Linear(float(wrap_deg(beta.c0 + 180.0)))
+@dataclass(frozen=True)
+class _Context:
+    """What candidate finding reads from the hierarchy (see :class:`~lsys_core.hierarchy.candidates.Context`)."""
 
-    def angle(v: Linear) -> None:
-        c0 = float(wrap_deg(v.c0)) if v.cd == 0 else v.c0
-        if abs(c0) > 1e-9 or v.cd != 0:
-            out.append(Turtle("+", Linear(_nice(c0, abs_tol=ANGLE_SNAP), _nice(v.cd, abs_tol=ANGLE_SNAP))))
+    table: SymbolTable
+    tol: Tolerance
 
-    angle(alpha)
-    if abs(d.c0) > 1e-12 or d.cd != 0:
-        out.append(
-            Turtle("f", Linear(_nice(d.c0, rel_tol=DISTANCE_SNAP), _nice(d.cd, rel_tol=DISTANCE_SNAP)))
-        )
-    if abs(s.c0 - 1.0) > 1e-9 or s.cd != 0:
-        out.append(Turtle("*", Linear(_nice(s.c0, rel_tol=SCALE_SNAP), _nice(s.cd, rel_tol=SCALE_SNAP))))
-    angle(beta)
-    return tuple(out)
-
-
-#: Levels of the hierarchy at most (each level codes at least one repetition).
-MAX_LEVELS = 100
-#: Scenes with more live nodes than this ignore candidates that repeat only twice (see :func:`_chance`).
-CHANCE_SCENE = 100
-#: A best candidate covering less than this share of the nodes is applied together with all
-#: other candidates on disjoint nodes (see :func:`_batch`).
-WEAK_COVER = 0.05
-
-#: Written values are the shortest decimals within these tolerances of the measured ones
-#: (degrees; relative for distances and scales, which compound along a sequence).
-ANGLE_SNAP = 1e-5
-DISTANCE_SNAP = 1e-6
-SCALE_SNAP = 5e-8
-
-
-def _nice(x: float, *, abs_tol: float = 0.0, rel_tol: float = 0.0) -> float:
-    """Return the decimal with the fewest digits within the tolerance of ``x`` (``45.0000049`` → ``45``)."""
-    x = float(x)
-    if x == 0 or not np.isfinite(x):
-        return 0.0 if x == 0 else x
-    tol = max(abs_tol, rel_tol * abs(x))
-    for digits in range(0, 12):
-        y = round(x, digits)
-        if abs(y - x) <= tol:
-            return y + 0.0
-    return float(f"{x:.12g}") + 0.0
-
-
-def _const_t(A: complex, B: complex) -> tuple[Module, ...]:
-    al, d, s, be = (float(v) for v in t4_from_rel(A, B))
-    return _t_modules(Linear(al), Linear(d), Linear(s), Linear(be))
-
-
-class _Builder:
-    """Mutable state of the hierarchy construction (symbols, rules, weights, bandwidths)."""
-
-    def __init__(self, terminal_names, terminal_sizes, a, b, center, radius, weights, tol, similarity):
-        self.syms: list[_Sym] = [
-            _Sym(nm, None, True, float(sz), nm) for nm, sz in zip(terminal_names, terminal_sizes, strict=True)
-        ]
-        self.sym_index: dict[tuple, int] = {("t", nm): i for i, nm in enumerate(terminal_names)}
-        self.rules: list[Rule] = []
-        self.rule_names: set[str] = set(terminal_names)
-        self.counters = {"P": 0, "R": 0, "X": 0}
-        self.weights = weights
-        self.tol = tol
-        self.similarity = similarity  # (n_terminals, n_terminals) similarity of terminal shapes
-        self.log: list[str] = []
-        self.n_terminals = len(terminal_names)
-
-    # -- symbols ---------------------------------------------------------------------------------
-    def new_name(self, prefix: str) -> str:
-        while True:
-            self.counters[prefix] += 1
-            name = f"{prefix}{self.counters[prefix]}"
-            if name not in self.rule_names:
-                self.rule_names.add(name)
-                return name
-
-    def sym_id(self, name: str, m: int | None, size: float, family: str) -> int:
-        key = ("r", name, m)
-        if key not in self.sym_index:
-            self.sym_index[key] = len(self.syms)
-            self.syms.append(_Sym(name, m, False, size, family))
-        return self.sym_index[key]
-
-    def draw(self, sid: int, last: bool = False) -> tuple[Module, ...]:
-        """Modules that draw symbol ``sid`` without moving the turtle (brackets for non-terminals)."""
-        s = self.syms[sid]
-        if s.terminal:
-            return (Symbol(s.name),)
-        mod = Symbol(s.name, Count(s.m) if s.m is not None else None)
-        return (mod,) if last else (Push(), mod, Pop())
+    def sizes(self) -> np.ndarray:
+        return self.table.sizes
 
     def phi(self, si: int, sj: int) -> float:
-        if si == sj:
-            return 1.0
-        a, b = self.syms[si], self.syms[sj]
-        if a.terminal and b.terminal:
-            return float(self.similarity[si, sj])
-        if a.family == b.family:
-            return 0.8
-        return 0.3
+        return self.table.phi(si, sj)
+
+
+class _Book:
+    """The rules written so far, the log, and which rule first covered every input element."""
+
+    def __init__(self, n_elements: int):
+        self.rules: list[Rule] = []
+        self.log: list[str] = []
+        self.node_rule = np.full(n_elements, -1, np.int64)
+
+    def add(self, rule: Rule, log: str, members: list[np.ndarray]) -> None:
+        for mem in members:
+            self.node_rule[mem[self.node_rule[mem] < 0]] = len(self.rules)
+        self.rules.append(rule)
+        self.log.append(log)
 
 
 def build_hierarchy(
@@ -239,97 +150,87 @@ def build_hierarchy(
     """
     nt = len(terminal_names)
     sim = similarity if similarity is not None else np.full((nt, nt), 0.5) + 0.5 * np.eye(nt)
-    bld = _Builder(terminal_names, terminal_sizes, a, b, center, radius, weights, tol, sim)
-    sym = np.asarray(group, dtype=np.int64).copy()
-    a = np.asarray(a, complex).copy()
-    b = np.asarray(b, complex).copy()
-    center = np.asarray(center, complex).copy()
-    radius = np.asarray(radius, float).copy()
-    members = [np.array([i]) for i in range(a.size)]
-    node_rule = np.full(a.size, -1, np.int64)
-    n0 = a.size
+    table = SymbolTable(terminal_names, terminal_sizes, sim)
+    ctx = _Context(table, tol)
+    book = _Book(np.asarray(a).size)
+    nodes = Nodes.of_elements(group, a, b, center, radius)
+    n0 = len(nodes)
     level = 0
     clock = timer if timer is not None else {}
     for k in ("transforms", "clustering", "rules"):
         clock.setdefault(k, 0.0)
-    dup = _duplicates(bld, sym, a, b)
+    dup = _duplicates(table, nodes)
     if dup:
         level += 1
-        sym, a, b, center, radius, members = _apply_all(
-            bld, dup, sym, a, b, center, radius, members, node_rule
-        )
-    while a.size > 1:
+        nodes = _apply_all(table, book, dup, nodes)
+    while len(nodes) > 1:
         check(cancel)
-        report(progress, "rules", 1.0 - (a.size - 1) / max(n0 - 1, 1))
+        report(progress, "rules", 1.0 - (len(nodes) - 1) / max(n0 - 1, 1))
         t0 = time.perf_counter()
-        ps = pair_space(a, b, center, radius, k=neighbours)
+        ps = pair_space(nodes.a, nodes.b, nodes.center, nodes.radius, k=neighbours)
         t1 = time.perf_counter()
-        cands = find_candidates(bld, sym, a, b, ps, radius)
+        cands = find_candidates(ctx, nodes.sym, ps, nodes.radius)
         t2 = time.perf_counter()
+        applied = False
         if cands and level < MAX_LEVELS:
-            first = np.array([m.min() for m in members])
-            for c in cands:
-                c.extra["start"] = float(np.mean([first[g[0]] for g in c.groups]))
-            best = _select(cands, bld.weights)
-            if _chance(best, a.size):
-                cands = []  # only coincidences left: place the remaining nodes as they are
-            else:
-                chosen = _batch(best, cands, a.size)
+            first = nodes.first_members()
+            cands = [replace(c, start=float(np.mean([first[g[0]] for g in c.groups]))) for c in cands]
+            scores = _scores(cands, weights)
+            best = _best(cands, scores)
+            if not _chance(cands[best], len(nodes)):
+                chosen = _batch(best, cands, scores, len(nodes))
                 level += 1
-                sym, a, b, center, radius, members = _apply_all(
-                    bld, chosen, sym, a, b, center, radius, members, node_rule
-                )
-        else:
-            cands = []
+                nodes = _apply_all(table, book, chosen, nodes)
+                applied = True
         clock["transforms"] += t1 - t0
         clock["clustering"] += t2 - t1
         clock["rules"] += time.perf_counter() - t2
-        if not cands:
+        if not applied:
             break
-    axiom: tuple[Module, ...]
-    if a.size == 1:
-        axiom = _const_t(a[0], b[0]) + bld.draw(int(sym[0]), last=True)
-    else:
-        name = "Z"
-        bld.rule_names.add(name)
-        body: list[Module] = []
-        a0, b0 = a[0], b[0]
-        for i in range(a.size):
-            t = _const_t(a[i] / a0, (b[i] - b0) / a0)
-            body += (
-                [Push(), *t, *bld.draw(int(sym[i]), last=True), Pop()]
-                if i
-                else [Push(), *bld.draw(int(sym[i]), last=True), Pop()]
-            )
-        bld.rules.append(Rule(name, False, (Case(None, tuple(body)),)))
-        bld.log.append(f"{name}: places the {a.size} remaining nodes")
-        axiom = (*_const_t(a0, b0), Symbol(name))
-        for mem in members:
-            node_rule[mem[node_rule[mem] < 0]] = len(bld.rules) - 1
+    axiom = _axiom(table, book, nodes)
     report(progress, "rules", 1.0)
-    return Hierarchy(bld.rules, axiom, level, node_rule, bld.log, closed=a.size == 1)
+    return Hierarchy(tuple(book.rules), axiom, level, book.node_rule, tuple(book.log), closed=len(nodes) == 1)
 
 
-def _duplicates(bld: _Builder, sym: np.ndarray, a: np.ndarray, b: np.ndarray) -> list[Candidate]:
+def _axiom(table: SymbolTable, book: _Book, nodes: Nodes) -> tuple[Module, ...]:
+    """The axiom: the last node, or a last rule placing the remaining nodes one by one."""
+    if len(nodes) == 1:
+        return const_t(nodes.a[0], nodes.b[0]) + table.draw(int(nodes.sym[0]), last=True)
+    name = table.new_name("Z")
+    body: list[Module] = []
+    a0, b0 = nodes.a[0], nodes.b[0]
+    for i in range(len(nodes)):
+        t = const_t(nodes.a[i] / a0, (nodes.b[i] - b0) / a0) if i else ()
+        body += [Push(), *t, *table.draw(int(nodes.sym[i]), last=True), Pop()]
+    book.add(
+        Rule(name, False, (Case(None, tuple(body)),)),
+        f"{name}: places the {len(nodes)} remaining nodes",
+        list(nodes.members),
+    )
+    return (*const_t(a0, b0), Symbol(name))
+
+
+def _duplicates(table: SymbolTable, nodes: Nodes) -> list[Candidate]:
     """Sequences with the identity transform for elements drawn several times at one pose.
 
     Stacked copies would otherwise pair with each other in arbitrary ways; coding each
     stack as ``P(m) -> A P(m-1)`` first keeps them (nothing is lost) and out of the way.
     """
-    sizes = np.array([s.size for s in bld.syms])[sym]
-    q = np.maximum(sizes * 1e-6, 1e-9)
+    sym, a, b = nodes.sym, nodes.a, nodes.b
+    q = np.maximum(table.sizes[sym] * 1e-6, 1e-9)
     key = np.column_stack(
         [sym, np.round(b.real / q), np.round(b.imag / q), np.round(a.real / 1e-6), np.round(a.imag / 1e-6)]
     )
     _, inv, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
     inv = inv.ravel()
-    out: dict[int, Candidate] = {}
+    stacks: dict[int, list[np.ndarray]] = {}
     for g in np.flatnonzero(counts >= 2):
-        nodes = np.flatnonzero(inv == g).tolist()
-        s = int(sym[nodes[0]])
-        cand = out.setdefault(s, Candidate("seq", (s, s), [], (1 + 0j, 0j)))
-        cand.groups.append(nodes)
-    return list(out.values())
+        members = np.flatnonzero(inv == g)
+        stacks.setdefault(int(sym[members[0]]), []).append(members)
+    return [
+        SeqCandidate(space=(s, s), groups=tuple(groups), h=1.0, phi=1.0, l=1.0, A=1 + 0j, B=0j)
+        for s, groups in stacks.items()
+    ]
 
 
 def _chance(best: Candidate, n_nodes: int) -> bool:
@@ -338,146 +239,56 @@ def _chance(best: Candidate, n_nodes: int) -> bool:
     Two repetitions of a transform among hundreds of unrelated elements happen by chance;
     coding them would add rules without describing any structure.
     """
-    repeats = len(best.groups) if best.kind != "seq" else sum(len(g) - 1 for g in best.groups)
-    return n_nodes > CHANCE_SCENE and repeats < 3 and best.covered < WEAK_COVER * n_nodes
+    return n_nodes > CHANCE_SCENE and best.repeats < 3 and best.covered < WEAK_COVER * n_nodes
 
 
-def _batch(best: Candidate, cands: list[Candidate], n_nodes: int) -> list[Candidate]:
+def _scores(cands: list[Candidate], w: Weights) -> np.ndarray:
+    """The importance ``w = wn·n + wh·h + wφ·φ + wl·l`` of every candidate (§5.4, eq. 5)."""
+    cov = max(c.covered for c in cands)
+    lmax = max(c.l for c in cands)
+    return np.array(
+        [w.wn * c.covered / cov + w.wh * min(c.h, 1.0) + w.wphi * c.phi + w.wl * (c.l / lmax) for c in cands]
+    )
+
+
+def _best(cands: list[Candidate], scores: np.ndarray) -> int:
+    """Index of the most important candidate.
+
+    Ties (e.g. a sequence read forwards or backwards) go to the order the art was drawn in.
+    """
+    return max(
+        range(len(cands)), key=lambda i: (round(float(scores[i]), 9), cands[i].covered, -cands[i].start)
+    )
+
+
+def _batch(best: int, cands: list[Candidate], scores: np.ndarray, n_nodes: int) -> list[Candidate]:
     """Return the candidates to apply at this level: the best one, or many weak ones at once.
 
     When the most important candidate covers only a small part of the scene (chance
     coincidences among clutter or duplicates), every other candidate on disjoint nodes is
     applied in the same level, in order of importance, so the number of levels stays small.
     """
-    if best.covered >= WEAK_COVER * n_nodes:
-        return [best]
+    if cands[best].covered >= WEAK_COVER * n_nodes:
+        return [cands[best]]
     taken = np.zeros(n_nodes, bool)
     out = []
-    for c in sorted(cands, key=lambda c: -c.score):
-        nodes = _nodes_of(c)
+    for i in sorted(range(len(cands)), key=lambda i: -scores[i]):
+        nodes = cands[i].nodes()
         if taken[nodes].any():
             continue
         taken[nodes] = True
-        out.append(c)
+        out.append(cands[i])
     return out
 
 
-def _nodes_of(c: Candidate) -> np.ndarray:
-    if c.kind == "branch":
-        return np.concatenate([t[2] for t in c.groups])
-    return np.concatenate([np.asarray(g) for g in c.groups])
-
-
-def _apply_all(bld: _Builder, chosen: list[Candidate], sym, a, b, center, radius, members, node_rule):
+def _apply_all(table: SymbolTable, book: _Book, chosen: list[Candidate], nodes: Nodes) -> Nodes:
     """Apply candidates on disjoint nodes one after another, renumbering the later ones' nodes."""
     for k, cand in enumerate(chosen):
-        sym, a, b, center, radius, members, mapping = _apply(
-            bld, cand, sym, a, b, center, radius, members, node_rule
-        )
-        for later in chosen[k + 1 :]:
-            _remap(later, mapping)
-    return sym, a, b, center, radius, members
-
-
-def _remap(c: Candidate, mapping: np.ndarray) -> None:
-    """Rewrite a candidate's node indices after another candidate was applied."""
-    if c.kind == "branch":
-        c.groups = [(int(mapping[r]), d, mapping[nodes]) for r, d, nodes in c.groups]
-    else:
-        c.groups = [[int(mapping[i]) for i in g] for g in c.groups]
-
-
-def _select(cands: list[Candidate], w: Weights) -> Candidate:
-    cov = max(c.covered for c in cands)
-    lmax = max(c.l for c in cands)
-    for c in cands:
-        c.n = c.covered / cov
-        c.score = w.wn * c.n + w.wh * min(c.h, 1.0) + w.wphi * c.phi + w.wl * (c.l / lmax)
-    # Ties (e.g. a sequence read forwards or backwards) go to the order the art was drawn in.
-    return max(cands, key=lambda c: (round(c.score, 9), c.covered, -c.extra.get("start", 0.0)))
-
-
-# ---------------------------------------------------------------------------------------------
-# Applying a candidate: emit its rule, replace its nodes
-
-
-def _apply(bld: _Builder, c: Candidate, sym, a, b, center, radius, members, node_rule):
-    si, sj = c.space
-    groups: list[np.ndarray] = []
-    new_syms: list[int] = []
-    rule_index = len(bld.rules)
-    if c.kind == "pair":
-        name = bld.new_name("X")
-        A, B = c.T
-        body = bld.draw(si) + _const_t(A, B) + bld.draw(sj, last=True)
-        bld.rules.append(Rule(name, False, (Case(None, body),)))
-        for ch in c.groups:
-            groups.append(np.array(ch))
-            new_syms.append(bld.sym_id(name, None, 0.0, name))
-        bld.log.append(f"{name}: {len(c.groups)} pairs {bld.syms[si].name}-{bld.syms[sj].name}")
-    elif c.kind == "seq":
-        name = bld.new_name("P")
-        A, B = c.T
-        t = _const_t(A, B)
-        gt = Case(COND_GT0, (*bld.draw(si), *t, Symbol(name, Count(-1, 1))))
-        eq = Case(COND_EQ0, bld.draw(si, last=True))
-        bld.rules.append(Rule(name, True, (gt, eq)))
-        for ch in c.groups:
-            groups.append(np.array(ch))
-            new_syms.append(bld.sym_id(name, len(ch) - 1, 0.0, name))
-        bld.log.append(
-            f"{name}: {len(c.groups)} sequences of {bld.syms[si].name}, lengths "
-            f"{sorted({len(ch) for ch in c.groups})}"
-        )
-    elif c.kind == "lin":
-        name = bld.new_name("P")
-        al0, d, s, be0, dA, dB, k = c.T
-        t = _t_modules(Linear(al0 + k * dA, -dA), Linear(d), Linear(s), Linear(be0 + k * dB, -dB))
-        gt = Case(COND_GT0, (*bld.draw(si), *t, Symbol(name, Count(-1, 1))))
-        eq = Case(COND_EQ0, bld.draw(si, last=True))
-        bld.rules.append(Rule(name, True, (gt, eq)))
-        for ch in c.groups:
-            groups.append(np.array(ch))
-            new_syms.append(bld.sym_id(name, len(ch) - 1, 0.0, name))
-        bld.log.append(f"{name}: {len(c.groups)} sequences with linear angles ({dA:.3g}°, {dB:.3g}°/step)")
-    else:  # branch
-        name = bld.new_name("R")
-        (A1, B1), (A2, B2) = c.T
-        rec = Symbol(name, Count(-1, 1))
-        gt = Case(COND_GT0, (*bld.draw(si), Push(), *_const_t(A1, B1), rec, Pop(), *_const_t(A2, B2), rec))
-        eq = Case(COND_EQ0, bld.draw(si, last=True))
-        bld.rules.append(Rule(name, True, (gt, eq)))
-        for root, depth, nodes in c.groups:
-            groups.append(np.concatenate([[root], nodes[nodes != root]]))
-            new_syms.append(bld.sym_id(name, depth, 0.0, name))
-        bld.log.append(
-            f"{name}: {len(c.groups)} branching structures, depths {sorted({g[1] for g in c.groups})}"
-        )
-    # Replace the covered nodes by one node each (pose of the first node).
-    keep = np.ones(a.size, bool)
-    add_a, add_b, add_c, add_r, add_s, add_m = [], [], [], [], [], []
-    for g, ns in zip(groups, new_syms, strict=True):
-        keep[g] = False
-        first = int(g[0])
-        cen = complex(np.mean(center[g]))
-        rad = float(np.max(np.abs(center[g] - cen) + radius[g]))
-        add_a.append(a[first])
-        add_b.append(b[first])
-        add_c.append(cen)
-        add_r.append(rad)
-        add_s.append(ns)
-        mem = np.concatenate([members[i] for i in g])
-        node_rule[mem[node_rule[mem] < 0]] = rule_index
-        add_m.append(mem)
-        if bld.syms[ns].size == 0.0:
-            bld.syms[ns].size = rad / abs(a[first])
-    kept = np.flatnonzero(keep)
-    sym = np.concatenate([sym[kept], np.array(add_s, np.int64)])
-    a = np.concatenate([a[kept], np.array(add_a, complex)])
-    b = np.concatenate([b[kept], np.array(add_b, complex)])
-    center = np.concatenate([center[kept], np.array(add_c, complex)])
-    radius = np.concatenate([radius[kept], np.array(add_r, float)])
-    members = [members[i] for i in kept] + add_m
-    mapping = np.full(keep.size, -1)
-    mapping[kept] = np.arange(kept.size)
-    return sym, a, b, center, radius, members, mapping
+        out = emit(table, cand)
+        book.add(out.rule, out.log, [np.concatenate([nodes.members[i] for i in g]) for g in out.groups])
+        nodes, mapping = nodes.merge(list(out.groups), list(out.syms))
+        new = np.arange(len(nodes) - len(out.groups), len(nodes))
+        for sid, i in zip(out.syms, new, strict=True):
+            table.set_size(sid, float(nodes.radius[i] / abs(nodes.a[i])))
+        chosen[k + 1 :] = [later.remapped(mapping) for later in chosen[k + 1 :]]
+    return nodes

@@ -1,0 +1,135 @@
+"""Cluster analysis (paper §5.3): the candidate rules of one level.
+
+Pairs of live nodes (:mod:`lsys_core.hierarchy.spaces`) are clustered by mean shift in each
+space of a pair of symbols.  Clusters *C* of (nearly) equal transforms give sequences
+(chains of pairs, r1/r2) and pairs of different symbols; two clusters of one space that
+share their first elements give branchings (full binary trees, r3/r4,
+:mod:`lsys_core.hierarchy.branching`); clusters *D* in the (d, s) subspace whose α and β
+change by a constant step give sequences with parameters linear in m
+(:mod:`lsys_core.hierarchy.linear`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from lsys_core.hierarchy.branching import branch_candidates
+from lsys_core.hierarchy.candidates import (
+    Candidate,
+    ConstantCluster,
+    Context,
+    PairCandidate,
+    SeqCandidate,
+    mean_rel,
+    proximity,
+    space_key,
+)
+from lsys_core.hierarchy.chains import chain_pairs, chains
+from lsys_core.hierarchy.clustering import group_indices, mean_shift
+from lsys_core.hierarchy.linear import linear_candidates
+from lsys_core.hierarchy.spaces import PairSpace
+
+__all__ = ["find_candidates"]
+
+
+def find_candidates(ctx: Context, sym: np.ndarray, ps: PairSpace, radius: np.ndarray) -> list[Candidate]:
+    """Return the candidate rules of one level.
+
+    Parameters
+    ----------
+    ctx : Context
+        Bandwidths, symbol sizes and symbol similarity.
+    sym : ndarray of int
+        Symbol of every live node.
+    ps : PairSpace
+        The pairs of this level and their relative transforms.
+    radius : ndarray
+        Radius of every live node's geometry.
+    """
+    if len(ps) == 0:
+        return []
+    tol = ctx.tol
+    size = np.maximum(ctx.sizes()[sym[ps.src]], 1e-9)
+    key = space_key(sym, ps)
+    th = np.angle(ps.A)
+    ang = np.deg2rad(tol.angle)
+    emb = np.column_stack(
+        [
+            ps.B.real / (tol.xy * size),
+            ps.B.imag / (tol.xy * size),
+            np.cos(th) / ang,
+            np.sin(th) / ang,
+            np.log(np.abs(ps.A)) / tol.scale,
+            key * 1e7,
+        ]
+    )
+    labels, _ = mean_shift(emb)
+    prox = proximity(ps, sym.size, radius)
+    n_nodes = sym.size
+    out: list[Candidate] = []
+    found: list[ConstantCluster] = []
+    pending: list[tuple[int, ConstantCluster]] = []
+    for idx in group_indices(labels):
+        if idx.size < 2:
+            continue  # a single pair repeats nothing
+        si, sj = int(sym[ps.src[idx[0]]]), int(sym[ps.dst[idx[0]]])
+        cost = np.linalg.norm(emb[idx, :5] - emb[idx, :5].mean(0), axis=1)
+        src, dst = ps.src[idx], ps.dst[idx]
+        chain_list, succ = chains(src, dst, cost)
+        if not chain_list:
+            continue
+        cluster = ConstantCluster((si, sj), idx, succ)
+        found.append(cluster)
+        used = chain_pairs(chain_list, src, dst, idx)
+        A, B = mean_rel(ps.A[used], ps.B[used])
+        lengths = [len(c) - 1 for c in chain_list]
+        if len(chain_list) < 2 and max(lengths) < 2:
+            continue
+        h, phi = float(np.mean(prox[used])), ctx.phi(si, sj)
+        cand: Candidate
+        if si == sj and max(lengths) >= 2:
+            groups = tuple(np.array(c) for c in chain_list)
+            cand = SeqCandidate(
+                space=(si, sj), groups=groups, h=h, phi=phi, l=float(np.mean(lengths)), A=A, B=B
+            )
+        else:
+            pairs = tuple(np.array(c[:2]) for c in chain_list)
+            cand = PairCandidate(space=(si, sj), groups=pairs, h=h, phi=phi, l=1.0, A=A, B=B)
+            if si != sj:
+                pending.append((len(out), cluster))
+        out.append(cand)
+    by_space: dict[tuple[int, int], list[ConstantCluster]] = {}
+    for cl in found:
+        by_space.setdefault(cl.space, []).append(cl)
+    for k, cl in pending:
+        out[k] = replace(out[k], l=_alternation_length(cl.succ, by_space.get(cl.space[::-1], [])))
+    same = {k: v for k, v in by_space.items() if k[0] == k[1]}
+    out += branch_candidates(ps, same, prox, n_nodes)
+    out += linear_candidates(ctx, sym, ps, prox, size, key)
+    return out
+
+
+def _alternation_length(succ: dict[int, int], back_clusters: list[ConstantCluster]) -> float:
+    """The length of the alternating sequences ``A B A B …`` that pairs ``A → B`` start.
+
+    When a cluster of B→A pairs links each pair's B to the A of the next pair, the pairs
+    are the steps of one sequence ``A T B T' A T B …``: merging them first lets the next
+    level code it with a single sequence rule.
+    """
+    best = 1.0
+    for back_cl in back_clusters[:4]:
+        back = back_cl.succ
+        targets = set(back.values())
+        lengths = []
+        for x in (x for x in succ if x not in targets):
+            n, cur, seen = 0, x, set()
+            while cur in succ and cur not in seen:
+                seen.add(cur)
+                n += 1
+                cur = back.get(succ[cur], -1)
+            lengths.append(n)
+        if lengths:
+            best = max(best, float(np.mean(lengths)))
+    return best

@@ -1,0 +1,110 @@
+"""The live nodes of one hierarchy level, as one typed struct of arrays (§5.6).
+
+At the first level every input element is a node: an instance of its terminal at its pose.
+Applying a rule replaces the nodes it explains by one node per application, an instance of
+the new non-terminal at the pose of the application's first node, so the next level pairs
+groups with groups.  Each node remembers the input elements it covers (``members``) and the
+bounding circle of their geometry (for neighbourhoods and proximity).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Nodes"]
+
+
+@dataclass(frozen=True, eq=False)
+class Nodes:
+    """Live nodes: symbol, pose, bounding circle and covered input elements of each.
+
+    Attributes
+    ----------
+    sym : ndarray of int64, shape (n,)
+        Symbol of every node (index into the hierarchy's symbol table).
+    a, b : ndarray of complex, shape (n,)
+        Pose ``z -> a*z + b`` of every node.
+    center : ndarray of complex, shape (n,)
+        Centre of the geometry the node covers (document coordinates).
+    radius : ndarray of float, shape (n,)
+        Radius of that geometry about ``center``.
+    members : tuple of ndarray of int
+        Input elements covered by every node.
+    """
+
+    sym: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    center: np.ndarray
+    radius: np.ndarray
+    members: tuple[np.ndarray, ...]
+
+    @classmethod
+    def of_elements(
+        cls, group: np.ndarray, a: np.ndarray, b: np.ndarray, center: np.ndarray, radius: np.ndarray
+    ) -> Nodes:
+        """Return the first level's nodes: one per input element (copies of the given arrays)."""
+        n = np.asarray(a).size
+        return cls(
+            np.asarray(group, dtype=np.int64).copy(),
+            np.asarray(a, complex).copy(),
+            np.asarray(b, complex).copy(),
+            np.asarray(center, complex).copy(),
+            np.asarray(radius, float).copy(),
+            tuple(np.array([i]) for i in range(n)),
+        )
+
+    def __len__(self) -> int:
+        return int(self.a.size)
+
+    def first_members(self) -> np.ndarray:
+        """Return the smallest input element index each node covers (the order it was drawn in)."""
+        return np.array([int(m.min()) for m in self.members], dtype=np.int64)
+
+    def merge(self, groups: list[np.ndarray], syms: list[int]) -> tuple[Nodes, np.ndarray]:
+        """Replace every group of nodes by one node of symbol ``syms[k]`` at its first node's pose.
+
+        Parameters
+        ----------
+        groups : list of ndarray of int
+            Disjoint groups of node indices, each with its first node first.
+        syms : list of int
+            The new node's symbol for every group.
+
+        Returns
+        -------
+        nodes : Nodes
+            The kept nodes in their order, then the new nodes in the order of ``groups``.
+        mapping : ndarray of int, shape (len(self),)
+            New index of every kept node; -1 for the merged ones.
+        """
+        n = len(self)
+        keep = np.ones(n, bool)
+        if not groups:
+            return self, np.arange(n)
+        flat = np.concatenate(groups)
+        keep[flat] = False
+        owner = np.repeat(np.arange(len(groups)), [g.size for g in groups])
+        counts = np.bincount(owner, minlength=len(groups))
+        cen = (
+            np.bincount(owner, self.center[flat].real, len(groups))
+            + 1j * np.bincount(owner, self.center[flat].imag, len(groups))
+        ) / counts
+        rad = np.zeros(len(groups))
+        np.maximum.at(rad, owner, np.abs(self.center[flat] - cen[owner]) + self.radius[flat])
+        first = np.array([int(g[0]) for g in groups], dtype=np.int64)
+        kept = np.flatnonzero(keep)
+        nodes = Nodes(
+            np.concatenate([self.sym[kept], np.asarray(syms, np.int64)]),
+            np.concatenate([self.a[kept], self.a[first]]),
+            np.concatenate([self.b[kept], self.b[first]]),
+            np.concatenate([self.center[kept], cen]),
+            np.concatenate([self.radius[kept], rad]),
+            tuple(self.members[i] for i in kept)
+            + tuple(np.concatenate([self.members[i] for i in g]) for g in groups),
+        )
+        mapping = np.full(n, -1)
+        mapping[kept] = np.arange(kept.size)
+        return nodes, mapping
