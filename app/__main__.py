@@ -1,5 +1,7 @@
 """Start the editor: ``lsys-editor [FILE.svg|FILE.lsys] [--screenshot OUT.png]``.
 
+``--help`` and ``--version`` answer before Qt is loaded (they work without a display or Qt).
+
 With ``--screenshot`` the editor opens the file, waits until inference, derivation and
 rendering have finished, saves a PNG of the whole window and exits (0 on success, 1 with a
 message on stderr otherwise).  It works offscreen (``QT_QPA_PLATFORM=offscreen``).
@@ -21,7 +23,10 @@ SCREENSHOT_TIMEOUT_S = 180
 
 def build_parser() -> argparse.ArgumentParser:
     """Return the command-line parser."""
+    from lsys_core import __version__
+
     p = argparse.ArgumentParser(prog="lsys-editor", description="Edit vector art as a parametric L-system.")
+    p.add_argument("--version", action="version", version=f"lsys-editor {__version__}")
     p.add_argument("file", nargs="?", help="an SVG to analyse, or an .lsys rules file")
     p.add_argument("--screenshot", metavar="OUT.png", help="save a PNG of the window once ready, then exit")
     p.add_argument("--size", default="1400x900", help="window size for --screenshot (default 1400x900)")

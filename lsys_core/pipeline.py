@@ -34,6 +34,9 @@ INFER_ERROR = 0.004
 #: Largest deviation (relative to the scene's diagonal) of an element from the terminal
 #: drawn in its place; elements farther from their group's shape get a terminal of their own.
 SHAPE_ERROR = 0.002
+#: Smallest clustering tolerance: below it no two transformations share a cluster anyway, and
+#: the bandwidth-scaled coordinates of a large scene would overflow the clustering's cell grid.
+MIN_TOLERANCE = 1e-6
 #: Scenes with more elements than this try fewer relaxed tolerances (see :func:`_factors`).
 LARGE_SCENE = 1000
 #: A relaxed grammar may deviate up to this much if it needs at most :data:`JITTER_GAIN`
@@ -81,8 +84,8 @@ class InferenceSettings:
                 raise InferenceError(f"weight {name} must be in [0, 1], got {v}")
         if not (0.0 < self.similarity <= 1.0):
             raise InferenceError(f"similarity threshold must be in (0, 1], got {self.similarity}")
-        if not (0.0 < self.tolerance <= 1000.0) or not np.isfinite(self.tolerance):
-            raise InferenceError(f"tolerance must be in (0, 1000], got {self.tolerance}")
+        if not (MIN_TOLERANCE <= self.tolerance <= 1000.0):
+            raise InferenceError(f"tolerance must be in [{MIN_TOLERANCE:g}, 1000], got {self.tolerance:g}")
         return self
 
 

@@ -45,7 +45,6 @@ from lsys_core.render.paths import (
     _Geometry,
     _geometry,
     _groups,
-    _number,
     _Paints,
     _paints,
     _path_from_arrays,
@@ -53,6 +52,8 @@ from lsys_core.render.paths import (
     _skia_paint,
     parse_style,
 )
+from lsys_core.render.skia_import import load_skia
+from lsys_core.render.units import CSS_DPI, length_px
 
 __all__ = ["MAX_PNG_PIXELS", "Renderer", "encode_png", "fit_view", "parse_style", "render", "render_png"]
 
@@ -532,8 +533,15 @@ def render(
     return _unpremultiply(pixels)
 
 
-def _png_size(drawing: Drawing, width: int | None, height: int | None) -> tuple[int, int]:
-    """Choose the PNG size: as given, else from the drawing's canvas with its aspect ratio."""
+def _png_size(
+    drawing: Drawing, width: int | None, height: int | None, dpi: float = CSS_DPI
+) -> tuple[int, int]:
+    """Choose the PNG size: as given, else the document's size in its units at ``dpi``, aspect kept.
+
+    Without ``width`` and ``height`` the size is the drawing's ``width``/``height`` converted
+    from their units (``cm``, ``in``, ``pt``, … at 96 CSS px per inch) to pixels at ``dpi``;
+    a missing or relative (``%``) size falls back to the viewBox size in user units.
+    """
     _, _, vw, vh = default_view(drawing)
     aspect = vw / vh if vw > 0 and vh > 0 else 1.0
     if width is not None and height is not None:
@@ -546,11 +554,16 @@ def _png_size(drawing: Drawing, width: int | None, height: int | None) -> tuple[
         h = max(1, round(w / aspect))
     else:
         size = drawing.size
-        fw = _number(size[0], vw) if size else vw
-        fh = _number(size[1], vh) if size else vh
-        if not (fw > 0 and fh > 0) or (size and ("%" in size[0] or "%" in size[1])):
+        given_w = length_px(size[0]) if size else None
+        given_h = length_px(size[1]) if size else None
+        if given_w is not None:
+            fw, fh = given_w, given_h if given_h is not None else given_w / aspect
+        elif given_h is not None:
+            fw, fh = given_h * aspect, given_h
+        else:
             fw, fh = vw, vh
-        w, h = max(1, round(fw)), max(1, round(fh))
+        scale = dpi / CSS_DPI
+        w, h = max(1, round(fw * scale)), max(1, round(fh * scale))
     w, h = min(w, MAX_SIDE), min(h, MAX_SIDE)
     if w * h > MAX_PNG_PIXELS:
         shrink = math.sqrt(MAX_PNG_PIXELS / (w * h))
@@ -564,22 +577,26 @@ def encode_png(
     height: int | None = None,
     *,
     background: tuple[int, int, int, int] = (255, 255, 255, 0),
+    dpi: float = CSS_DPI,
 ) -> bytes:
     """Render a drawing and return the bytes of a PNG file.
 
-    Without ``width`` and ``height`` the drawing's ``width``/``height`` (in px) or
-    viewBox size is used; with one of them the other follows the aspect ratio.  Sides
-    are capped at :data:`MAX_SIDE` and the image at :data:`MAX_PNG_PIXELS` pixels
-    (scaled down, aspect ratio kept), so an absurd canvas size cannot exhaust memory.
+    Without ``width`` and ``height`` the drawing's ``width``/``height`` in their units
+    at ``dpi`` dots per inch (96: one pixel per CSS pixel), or its viewBox size, is used;
+    with one of them the other follows the aspect ratio.  Sides are capped at
+    :data:`MAX_SIDE` and the image at :data:`MAX_PNG_PIXELS` pixels (scaled down, aspect
+    ratio kept), so an absurd canvas size cannot exhaust memory.
 
     Raises
     ------
     LsysError
-        When the image cannot be encoded.
+        When the image cannot be encoded, or skia cannot be loaded (naming the missing
+        system library).
     """
-    import skia
-
-    w, h = _png_size(drawing, width, height)
+    skia = load_skia()
+    if not (math.isfinite(dpi) and dpi > 0):
+        raise LsysError(f"the resolution must be a positive number of dots per inch, got {dpi}")
+    w, h = _png_size(drawing, width, height, dpi)
     renderer = Renderer(w, h)
     renderer.draw(drawing, None, True, False, background=background)
     image = renderer._surface.makeImageSnapshot()
@@ -596,10 +613,11 @@ def render_png(
     height: int | None = None,
     *,
     background: tuple[int, int, int, int] = (255, 255, 255, 0),
+    dpi: float = CSS_DPI,
 ) -> None:
     """Render a drawing and write it as a PNG file atomically (see :func:`encode_png`)."""
     try:
-        data = encode_png(drawing, width, height, background=background)
+        data = encode_png(drawing, width, height, background=background, dpi=dpi)
     except LsysError as exc:
         raise LsysError(f"cannot write {path}: {exc}") from exc
     write_atomic(path, data)

@@ -7,8 +7,8 @@ import stat
 
 import pytest
 
-from lsys_core import io as lio
 from lsys_core.errors import LsysError
+from lsys_core.io import write as lio
 from lsys_core.io import write_atomic
 
 

@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 
 from lsys_core import cli
-from lsys_core import io as lio
 from lsys_core.derive.derivation import derive
 from lsys_core.derive.model import Drawing
 from lsys_core.errors import GrammarSyntaxError, LsysError
 from lsys_core.grammar import parse_grammar
+from lsys_core.io import write as lio
 from lsys_core.io import write_files_atomic
 from lsys_core.render import drawing_to_svg, export_svg
 from lsys_core.render import raster as render
@@ -199,7 +199,7 @@ def test_an_unexpected_exception_is_one_line_and_exit_70(tmp_path, monkeypatch, 
     def broken(*args, **kwargs):
         raise RuntimeError("simulated bug\nwith two lines")
 
-    monkeypatch.setattr(cli, "_derive", broken)
+    monkeypatch.setattr(cli.commands, "_derive", broken)
     monkeypatch.delenv("LSYS_DEBUG", raising=False)
     assert cli.main(["derive", str(rules), "-o", str(tmp_path / "o.svg")]) == 70
     err = capsys.readouterr().err
