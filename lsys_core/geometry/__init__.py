@@ -14,6 +14,7 @@ from lsys_core.geometry.bezier import (
     transform_cubics,
 )
 from lsys_core.geometry.paths import MAX_COORD, cubics_from_d, d_from_cubics
+from lsys_core.geometry.shapes import shape_arrays
 from lsys_core.geometry.transforms import DEG, frames_to_matrices, wrap_deg
 
 __all__ = [
@@ -26,6 +27,7 @@ __all__ = [
     "frames_to_matrices",
     "sample_cubics",
     "sample_uniform",
+    "shape_arrays",
     "transform_cubics",
     "wrap_deg",
 ]

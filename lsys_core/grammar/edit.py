@@ -19,9 +19,9 @@ __all__ = ["drop_unreachable", "replace_terminal", "replace_with_terminal", "set
 
 def _shape_circle(path: str) -> tuple[complex, float]:
     """Centre and radius of the control polygon of SVG path data."""
-    from lsys_core.geometry.paths import cubics_from_d
+    from lsys_core.geometry.shapes import shape_arrays
 
-    cubics, _, _ = cubics_from_d(path)
+    cubics, _, _ = shape_arrays(path)
     if cubics.size == 0:
         raise GrammarError("the new shape has no drawable segments")
     pts = cubics.reshape(-1)

@@ -379,12 +379,13 @@ def path_problem(d: str) -> str | None:
         ``"invalid path data ..."`` or ``"path data has non-finite or huge coordinates"``.
     """
     from lsys_core.errors import SvgError
-    from lsys_core.geometry.paths import MAX_COORD, cubics_from_d
+    from lsys_core.geometry.paths import MAX_COORD
+    from lsys_core.geometry.shapes import shape_arrays
 
     if not d.strip():
         return None
     try:
-        cubics, _, _ = cubics_from_d(d)
+        cubics, _, _ = shape_arrays(d)
     except SvgError as exc:
         return str(exc)
     with np.errstate(invalid="ignore"):

@@ -106,13 +106,14 @@ def recenter(inst: Instancing, offsets: np.ndarray) -> Instancing:
     """Move terminal origins by ``offsets`` (local coordinates): shapes shift, poses follow."""
     if not np.any(offsets):
         return inst
-    from lsys_core.geometry.paths import cubics_from_d, d_from_cubics
+    from lsys_core.geometry.paths import d_from_cubics
+    from lsys_core.geometry.shapes import shape_arrays
 
     terminals = list(inst.terminals)
     for g, o in enumerate(offsets):
         if o == 0:
             continue
-        cubics, subpaths, closed = cubics_from_d(terminals[g].path)
+        cubics, subpaths, closed = shape_arrays(terminals[g].path)
         terminals[g] = replace(terminals[g], path=d_from_cubics(cubics - o, subpaths, closed))
     b = inst.b + inst.a * offsets[inst.group]
     return replace(inst, b=b, terminals=tuple(terminals))

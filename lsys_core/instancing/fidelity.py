@@ -32,11 +32,11 @@ def _deviations(
     scene: Scene, inst: Instancing, radius: np.ndarray, tol: float, absolute: float
 ) -> np.ndarray:
     """Deviation of every element from its posed terminal, in units of its allowance (> 1: too far)."""
-    from lsys_core.geometry.paths import cubics_from_d
+    from lsys_core.geometry.shapes import shape_arrays
     from lsys_core.instancing.sampling import arc_fractions, sample_elements
 
     els = sample_elements(scene.elements, arc_fractions(48))
-    terms = tuple(Element(*cubics_from_d(t.path)) for t in inst.terminals)
+    terms = tuple(Element(*shape_arrays(t.path)) for t in inst.terminals)
     reps = sample_elements(terms, arc_fractions(512))
     dev = np.zeros(len(scene.elements))
     for g in range(len(inst.terminals)):

@@ -404,10 +404,10 @@ def terminal_similarity(
     ndarray of float, shape (k, k)
         Symmetric, 1 on the diagonal; 0 between a drawable shape and an empty one.
     """
-    from lsys_core.geometry.paths import cubics_from_d
+    from lsys_core.geometry.shapes import shape_arrays
 
     k = len(terminals)
-    elements = tuple(Element(*cubics_from_d(t.path)) for t in terminals)
+    elements = tuple(Element(*shape_arrays(t.path)) for t in terminals)
     sim = np.eye(k)
     if k < 2:
         return sim

@@ -159,12 +159,11 @@ _EMPTY = _Geometry(
 
 def _geometry(d: str) -> _Geometry:
     """Turn path data into skia points and verbs (lines where control points sit at thirds)."""
-    from lsys_core.geometry.paths import _collinear_thirds, cubics_from_d
+    from lsys_core.geometry.paths import _collinear_thirds
+    from lsys_core.geometry.shapes import shape_arrays
 
     try:
-        cubics, subpaths, closed = (
-            cubics_from_d(d) if d.strip() else (np.zeros((0, 4), complex), np.zeros(0, int), ())
-        )
+        cubics, subpaths, closed = shape_arrays(d)
     except LsysError:
         return _EMPTY
     k = len(cubics)

@@ -16,7 +16,7 @@ import numpy as np
 
 from lsys_core.derive.model import Drawing
 from lsys_core.errors import LsysError
-from lsys_core.geometry.paths import cubics_from_d
+from lsys_core.geometry.shapes import shape_arrays
 from lsys_core.io import write_atomic
 
 __all__ = ["check_finite", "drawing_bounds", "drawing_to_svg", "export_svg", "terminal_points"]
@@ -38,9 +38,7 @@ def terminal_points(drawing: Drawing) -> list[np.ndarray]:
     """Return the control points of each terminal's path (local frame; empty if it has none)."""
     out = []
     for term in drawing.terminals:
-        cubics, _, _ = (
-            cubics_from_d(term.path) if term.path.strip() else (np.zeros((0, 4), complex), None, None)
-        )
+        cubics, _, _ = shape_arrays(term.path)
         out.append(np.unique(cubics.ravel()) if cubics.size else np.zeros(0, dtype=complex))
     return out
 

@@ -1,0 +1,75 @@
+"""Terminal shapes parsed once: cubic arrays of path data, cached by the path text.
+
+A terminal keeps its shape as SVG path data (what the ``.lsys`` file says is what is drawn), and
+many stages need its arrays: fidelity and shape similarity, pivots, validation, SVG export and
+raster rendering.  :func:`shape_arrays` parses each distinct path text once and hands every later
+caller the same read-only arrays.  The cache is bounded by the number of segments it holds, so a
+session that edits many shapes does not grow without limit.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections import OrderedDict
+
+import numpy as np
+
+from lsys_core.geometry.paths import cubics_from_d
+
+__all__ = ["CACHE_SEGMENTS", "shape_arrays"]
+
+#: Segments kept in the cache at most (about 72 bytes each); a larger shape is parsed, not kept.
+CACHE_SEGMENTS = 250_000
+
+_Arrays = tuple[np.ndarray, np.ndarray, tuple[bool, ...]]
+
+_cache: OrderedDict[str, _Arrays] = OrderedDict()
+_held = 0  # segments in the cache
+_lock = threading.Lock()  # the editor renders while a worker thread infers
+
+
+def shape_arrays(d: str) -> _Arrays:
+    """Return the cubic arrays of path data ``d``, parsing each distinct text only once.
+
+    Parameters
+    ----------
+    d : str
+        SVG path data; blank text is an empty shape.
+
+    Returns
+    -------
+    cubics : ndarray of complex, shape (k, 4)
+    subpaths : ndarray of int, shape (k,)
+    closed : tuple of bool
+        As :func:`~lsys_core.geometry.paths.cubics_from_d` returns them, but read-only: they are
+        shared by every caller asking for the same text.
+
+    Raises
+    ------
+    SvgError
+        If the path data cannot be parsed (not cached: every call raises again).
+    """
+    global _held
+    with _lock:
+        hit = _cache.get(d)
+        if hit is not None:
+            _cache.move_to_end(d)
+            return hit
+    if d.strip():
+        cubics, subpaths, closed = cubics_from_d(d)
+    else:
+        cubics, subpaths, closed = np.zeros((0, 4), complex), np.zeros(0, np.intp), ()
+    cubics.setflags(write=False)
+    subpaths.setflags(write=False)
+    arrays = (cubics, subpaths, closed)
+    k = len(cubics)
+    if k > CACHE_SEGMENTS:
+        return arrays
+    with _lock:
+        if d not in _cache:
+            _cache[d] = arrays
+            _held += k
+            while _held > CACHE_SEGMENTS:
+                _, old = _cache.popitem(last=False)
+                _held -= len(old[0])
+    return arrays

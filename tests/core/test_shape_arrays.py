@@ -1,0 +1,48 @@
+"""Terminal path data is parsed once: shared read-only arrays, bounded cache, errors not cached."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lsys_core.errors import SvgError
+from lsys_core.geometry import shapes
+from lsys_core.geometry.paths import cubics_from_d
+from lsys_core.geometry.shapes import shape_arrays
+
+
+def test_same_text_gives_the_same_read_only_arrays() -> None:
+    d = "M0 0 L10 0 C12 1 12 4 10 5 Z"
+    first = shape_arrays(d)
+    again = shape_arrays(d)
+    assert again[0] is first[0] and again[1] is first[1]
+    expected = cubics_from_d(d)
+    np.testing.assert_array_equal(first[0], expected[0])
+    np.testing.assert_array_equal(first[1], expected[1])
+    assert first[2] == expected[2]
+    with pytest.raises(ValueError):
+        first[0][0, 0] = 99.0  # shared by every caller: nobody may change it
+
+
+def test_blank_text_is_an_empty_shape() -> None:
+    cubics, subpaths, closed = shape_arrays("  ")
+    assert cubics.shape == (0, 4) and subpaths.shape == (0,) and closed == ()
+
+
+def test_bad_path_data_raises_every_time() -> None:
+    for _ in range(2):
+        with pytest.raises(SvgError):
+            shape_arrays("M0 0 Lx")
+    assert "M0 0 Lx" not in shapes._cache
+
+
+def test_cache_holds_a_bounded_number_of_segments(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(shapes, "CACHE_SEGMENTS", 10)
+    monkeypatch.setattr(shapes, "_cache", type(shapes._cache)())
+    monkeypatch.setattr(shapes, "_held", 0)
+    for i in range(20):
+        shape_arrays(f"M{i} 0 L{i + 1} 0 L{i + 1} 1")  # two segments each
+    assert shapes._held <= 10
+    assert sum(len(v[0]) for v in shapes._cache.values()) == shapes._held
+    big = "M0 0 " + " ".join(f"L{i} {i % 2}" for i in range(1, 30))
+    assert len(shape_arrays(big)[0]) > 10 and big not in shapes._cache
