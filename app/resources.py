@@ -1,4 +1,4 @@
-"""Where the bundled resources (examples, icons) are: the checkout, or a frozen bundle."""
+"""Where the bundled resources (examples, icons) are: installed package, frozen bundle or checkout."""
 
 from __future__ import annotations
 
@@ -12,14 +12,19 @@ APP_ID = "io.github.lsys_editor.LsysEditor"
 
 
 def resource_dir() -> Path | None:
-    """Return the ``resources`` folder (PyInstaller's ``_MEIPASS`` first), or None."""
-    roots = []
+    """Return the ``resources`` folder, or None.
+
+    Looked up in a PyInstaller bundle (``_MEIPASS``), then inside the package (where
+    ``pip install`` puts it: ``lsys_editor/resources``), then in the checkout beside ``app/``.
+    """
+    here = Path(__file__).resolve().parent
+    candidates = []
     if getattr(sys, "_MEIPASS", None):
-        roots.append(Path(sys._MEIPASS))
-    roots.append(Path(__file__).resolve().parents[1])
-    for root in roots:
-        if (root / "resources").is_dir():
-            return root / "resources"
+        candidates.append(Path(sys._MEIPASS) / "resources")
+    candidates += [here / "resources", here.parent / "resources"]
+    for folder in candidates:
+        if (folder / "examples").is_dir():
+            return folder
     return None
 
 

@@ -5,6 +5,6 @@ import sys
 
 if __name__ == "__main__":
     multiprocessing.freeze_support()  # the editor's inference worker re-enters here with spawn
-    from app.__main__ import main
+    from lsys_editor.__main__ import main
 
     sys.exit(main())

@@ -77,7 +77,7 @@ def test_metainfo_names_the_app_its_launcher_and_both_binaries() -> None:
     assert sorted(b.text for b in root.findall("provides/binary")) == sorted(scripts())
     with open(ROOT / "pyproject.toml", "rb") as fh:
         project = tomllib.load(fh)["project"]
-    assert root.findtext("project_license") == project["license"]["text"]
+    assert root.findtext("project_license") == project["license"]
     assert root.find("releases/release").get("version") == project["version"]
 
 
