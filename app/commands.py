@@ -1,28 +1,39 @@
-"""Undoable edits of a :class:`~app.document.Document` (QUndoCommand subclasses).
+"""Undoable edits (QUndoCommand subclasses) of anything that implements :class:`EditTarget`.
 
-Every command stores whole before/after values (rule text, settings, randomization), so undo
-and redo never recompute anything expensive: undoing a weight change restores the previous
-rules text instead of re-running inference.  Commands made during one gesture (a slider drag)
-merge into one undo step; consecutive typing in the rules editor merges too.
+Every command stores whole before/after values (rule text, settings), so undo and redo never
+recompute anything expensive: undoing a weight change restores the previous rules text instead
+of re-running inference.  Commands made during one gesture (a slider or handle drag) merge into
+one undo step; consecutive typing in the rules editor merges too.
+
+Commands know the document only through :class:`EditTarget`, two public methods that apply a
+value; this module imports nothing of the editor.
 """
 
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 from PySide6.QtGui import QUndoCommand
 
-if TYPE_CHECKING:
-    from .document import Document
-
-__all__ = ["RandomizeCommand", "SettingsCommand", "TextCommand"]
+__all__ = ["EditTarget", "SettingsCommand", "TextCommand"]
 
 _TYPING_MERGE_SECONDS = 1.5
 
 _ID_TEXT = 1
 _ID_SETTINGS = 2
-_ID_RANDOMIZE = 3
+
+
+class EditTarget(Protocol):
+    """What a command edits: the document's rules text and inference settings."""
+
+    def apply_text(
+        self, text: str, *, grammar: Any = None, drawing: Any = None, typing: bool = False
+    ) -> None:
+        """Show ``text`` as the rules (``grammar``/``drawing``: its parse and derivation if known)."""
+
+    def apply_settings(self, settings: Any) -> None:
+        """Show ``settings`` as the settings the rules were inferred with (no inference runs)."""
 
 
 class TextCommand(QUndoCommand):
@@ -30,22 +41,22 @@ class TextCommand(QUndoCommand):
 
     Parameters
     ----------
-    doc : Document
+    target : EditTarget
         The document edited.
     label : str
         Text of the Undo/Redo menu entries.
     old, new : str
         Rules text before and after.
     merge_key : object, optional
-        Consecutive commands with the same non-None key merge into one step (a slider drag,
-        or typing, which merges while keystrokes follow each other closely).
+        Consecutive commands with the same non-None key merge into one step (a drag, or
+        typing, which merges while keystrokes follow each other closely).
     grammar, drawing : optional
         The parsed grammar and derived drawing of ``new`` if already known (first redo only).
     """
 
     def __init__(
         self,
-        doc: Document,
+        target: EditTarget,
         label: str,
         old: str,
         new: str,
@@ -55,7 +66,7 @@ class TextCommand(QUndoCommand):
         drawing: Any = None,
     ) -> None:
         super().__init__(label)
-        self.doc = doc
+        self.target = target
         self.old = old
         self.new = new
         self.merge_key = merge_key
@@ -75,35 +86,51 @@ class TextCommand(QUndoCommand):
             return False
         self.new = other.new
         self._stamp = other._stamp
+        if self.new == self.old:
+            self.setObsolete(True)  # the gesture came back to where it started: no step
         return True
 
     def redo(self) -> None:
         """Apply the new text."""
-        self.doc._apply_text(
+        self.target.apply_text(
             self.new, grammar=self._grammar, drawing=self._drawing, typing=self.merge_key == "typing"
         )
         self._grammar = self._drawing = None
 
     def undo(self) -> None:
         """Restore the old text."""
-        self.doc._apply_text(self.old)
+        self.target.apply_text(self.old)
 
 
 class SettingsCommand(QUndoCommand):
-    """Change the inference settings; the rules text follows when inference finishes.
+    """A finished re-inference with new settings: the settings and the rules text they produced.
 
-    The first redo runs inference; its result is recorded in :attr:`new_text`, so later
-    undo/redo only swap texts.  Commands of one slider drag merge.
+    Pushed when the inference result arrives (never before, so a cancelled run leaves no step);
+    its first redo applies the result, later undo/redo only swap settings and texts.  Results
+    of one slider drag merge into one step.
     """
 
-    def __init__(self, doc: Document, old: Any, new: Any, old_text: str, *, merge_key: Any = None) -> None:
+    def __init__(
+        self,
+        target: EditTarget,
+        old: Any,
+        new: Any,
+        old_text: str,
+        new_text: str,
+        *,
+        merge_key: Any = None,
+        grammar: Any = None,
+        drawing: Any = None,
+    ) -> None:
         super().__init__("Change inference settings")
-        self.doc = doc
+        self.target = target
         self.old = old
         self.new = new
         self.old_text = old_text
-        self.new_text: str | None = None
+        self.new_text = new_text
         self.merge_key = merge_key
+        self._grammar = grammar
+        self._drawing = drawing
 
     def id(self) -> int:
         """Return the merge id shared by all settings commands."""
@@ -118,36 +145,18 @@ class SettingsCommand(QUndoCommand):
         ):
             return False
         self.new = other.new
-        self.new_text = None
-        self.doc._retarget_inference(other, self)
+        self.new_text = other.new_text
+        if self.new == self.old and self.new_text == self.old_text:
+            self.setObsolete(True)
         return True
 
     def redo(self) -> None:
-        """Apply the new settings; infer unless the resulting text is known."""
-        self.doc._apply_settings(self.new, self.new_text, command=self)
+        """Apply the new settings and the rules they produced."""
+        self.target.apply_settings(self.new)
+        self.target.apply_text(self.new_text, grammar=self._grammar, drawing=self._drawing)
+        self._grammar = self._drawing = None
 
     def undo(self) -> None:
         """Restore the old settings and the rules text they had produced."""
-        self.doc._apply_settings(self.old, self.old_text, command=None)
-
-
-class RandomizeCommand(QUndoCommand):
-    """Set or clear the random perturbation of the derivation."""
-
-    def __init__(self, doc: Document, old: Any, new: Any) -> None:
-        super().__init__("Randomize" if new is not None else "Clear randomization")
-        self.doc = doc
-        self.old = old
-        self.new = new
-
-    def id(self) -> int:
-        """Return the id of randomize commands (they do not merge)."""
-        return _ID_RANDOMIZE
-
-    def redo(self) -> None:
-        """Apply the new randomization."""
-        self.doc._apply_randomize(self.new)
-
-    def undo(self) -> None:
-        """Restore the previous randomization."""
-        self.doc._apply_randomize(self.old)
+        self.target.apply_settings(self.old)
+        self.target.apply_text(self.old_text)

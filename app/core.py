@@ -13,7 +13,6 @@ import dataclasses
 from pathlib import Path
 from typing import Any
 
-from lsys_core.derive.derivation import Randomize
 from lsys_core.errors import LsysError
 
 __all__ = [
@@ -30,11 +29,11 @@ __all__ = [
     "load_svg",
     "make_renderer",
     "parse_grammar",
-    "randomize_from_dict",
     "read_text",
     "replace_terminal",
     "replace_with_terminal",
     "set_param",
+    "set_params",
     "settings_from_dict",
     "shape_from_svg",
     "symmetrize",
@@ -84,14 +83,6 @@ def settings_from_dict(values: dict[str, Any]) -> Any:
     return cls(**{k: v for k, v in values.items() if k in names})
 
 
-def randomize_from_dict(values: dict[str, Any] | None) -> Randomize | None:
-    """Build a ``Randomize`` from a dict (None stays None)."""
-    if not values:
-        return None
-    names = {f.name for f in dataclasses.fields(Randomize)}
-    return Randomize(**{k: v for k, v in values.items() if k in names})
-
-
 def parse_grammar(text: str) -> Any:
     """Parse ``.lsys`` text, terminal path data included (raises ``GrammarSyntaxError`` with line and column)."""
     from lsys_core.grammar import parse_grammar as _parse
@@ -118,6 +109,13 @@ def set_param(grammar: Any, key: str, value: float) -> Any:
     from lsys_core.grammar import set_param as _set
 
     return _set(grammar, key, value)
+
+
+def set_params(grammar: Any, values: dict[str, float]) -> Any:
+    """Return ``grammar`` with several parameters changed."""
+    from lsys_core.grammar import set_params as _set
+
+    return _set(grammar, values)
 
 
 def replace_terminal(grammar: Any, name: str, path_d: str, style: str) -> Any:

@@ -25,7 +25,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from lsys_core.derive.derivation import Randomize
+from lsys_core.grammar.model import Randomize
 
 __all__ = ["RandomizeDialog", "ReplaceChoice", "ReplaceDialog"]
 
@@ -33,15 +33,16 @@ SEED_MAX = 2**31 - 1
 
 
 class RandomizeDialog(QDialog):
-    """Amounts of random perturbation (angle in degrees, distance and scale as fractions) and a seed.
+    """Amounts of random perturbation (angle in degrees, distance and scale as fractions), a seed
+    and whether each instance moves on its own or the perturbation accumulates along a sequence.
 
-    *Re-roll* picks a new seed and applies it at once, so the user sees the variation; *OK*
-    keeps the shown values, *Cancel* restores the randomization the dialog started with.
+    *Apply* and *Re-roll* (a new seed) preview the shown values on the canvas; *OK* keeps
+    them (one undo step, saved in the ``.lsys`` file), *Cancel* returns to the rules' own.
 
     Signals
     -------
     applied(randomize)
-        Emitted on Re-roll and Apply with the shown :class:`~lsys_core.derive.derivation.Randomize`.
+        Emitted on Re-roll and Apply with the shown :class:`~lsys_core.grammar.model.Randomize`.
     """
 
     applied = Signal(object)
@@ -50,13 +51,17 @@ class RandomizeDialog(QDialog):
         super().__init__(parent)
         self.setWindowTitle("Randomize")
         self.initial = current
-        r = current or Randomize(angle=5.0, distance=0.05, scale=0.02, seed=1)
+        r = current or Randomize(angle=5.0, distance=0.05, scale=0.02, seed=1, jitter="instance")
         self.angle = self._spin(0, 180, r.angle, 1.0, " °")
         self.distance = self._spin(0, 1, r.distance, 0.01, "")
         self.scale = self._spin(0, 1, r.scale, 0.01, "")
         self.seed = QSpinBox(self)
         self.seed.setRange(0, SEED_MAX)
         self.seed.setValue(int(r.seed))
+        self.jitter = QComboBox(self)
+        self.jitter.addItem("Each instance on its own", "instance")
+        self.jitter.addItem("Cumulative (drifts along a sequence)", "cumulative")
+        self.jitter.setCurrentIndex(max(0, self.jitter.findData(r.jitter)))
         reroll = QPushButton("Re-roll", self)
         reroll.clicked.connect(self.reroll)
         seed_row = QHBoxLayout()
@@ -67,6 +72,7 @@ class RandomizeDialog(QDialog):
         form.addRow("Distance (± fraction)", self.distance)
         form.addRow("Scale (± fraction)", self.scale)
         form.addRow("Seed", seed_row)
+        form.addRow("Jitter", self.jitter)
         buttons = QDialogButtonBox(
             QDialogButtonBox.StandardButton.Ok
             | QDialogButtonBox.StandardButton.Apply
@@ -77,7 +83,9 @@ class RandomizeDialog(QDialog):
         buttons.rejected.connect(self.reject)
         buttons.button(QDialogButtonBox.StandardButton.Apply).clicked.connect(self.apply)
         layout = QVBoxLayout(self)
-        layout.addWidget(QLabel("Every rule application is perturbed by a seeded random amount.", self))
+        layout.addWidget(
+            QLabel("Every instance drawn by a rule is perturbed by a seeded random amount.", self)
+        )
         layout.addLayout(form)
         layout.addWidget(buttons)
 
@@ -97,6 +105,7 @@ class RandomizeDialog(QDialog):
             distance=self.distance.value(),
             scale=self.scale.value(),
             seed=self.seed.value(),
+            jitter=self.jitter.currentData(),
         )
 
     def apply(self) -> None:

@@ -1,13 +1,18 @@
-"""The editor's document: input scene, rules text, grammar, drawing, settings and undo stack.
+"""The editor's document: input scene, rules, inference settings, files and the undo stack.
 
-The :class:`Document` holds the state every widget shows and is the only thing widgets edit.
-It contains no algorithm: parsing, inference, derivation and editing are calls into
-``lsys_core``; inference and derivation run on worker threads through
-:class:`~app.workers.LatestRunner` (request → compute → apply, newest result wins).
+The :class:`Document` holds what every widget shows and is the only thing widgets edit.  It
+contains no algorithm and delegates by responsibility:
 
-State flows one way: an edit changes the rules *text* (the source of truth, pushed as an
-undoable command), the text is parsed into a *grammar*, the grammar is derived into a
-*drawing*.  While the text does not parse, the last valid grammar and drawing stay.
+* :class:`~app.rules_model.RulesModel` keeps text → grammar → drawing consistent;
+* :class:`~app.inference_control.InferenceControl` runs inference in the background and says
+  what each run was for;
+* :mod:`app.commands` are the undoable steps, which call back only :meth:`Document.apply_text`
+  and :meth:`Document.apply_settings`.
+
+Invariants: :attr:`settings` are those the rules on the canvas were inferred with (a weight
+change in flight is :attr:`pending_settings` until its result arrives, and a cancelled run
+restores the panel); every user action that changes the rules is exactly one undo step, and an
+action that changes nothing pushes no step and says why.
 """
 
 from __future__ import annotations
@@ -18,28 +23,18 @@ import os
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import QObject, QTimer, Signal
+from PySide6.QtCore import QObject, Signal
 from PySide6.QtGui import QUndoStack
 
-from lsys_core.derive.derivation import Randomize
-from lsys_core.errors import GrammarError, LsysError
+from lsys_core.errors import LsysError
 
 from . import core
-from .commands import RandomizeCommand, SettingsCommand, TextCommand
-from .jobs import DeriveRequest, InferOutcome, InferRequest, run_derive, run_inference
-from .workers import LatestRunner, ProcessCompute
+from .commands import SettingsCommand, TextCommand
+from .inference_control import INFER_PRELOAD, InferenceControl, Purpose
+from .jobs import InferOutcome, InferRequest
+from .rules_model import RulesModel
 
-__all__ = ["Document"]
-
-PARSE_DELAY_MS = 150
-INFER_DELAY_MS = 80
-#: Modules the inference process imports as it starts (while the window opens).
-INFER_PRELOAD = (
-    "lsys_core.pipeline",
-    "lsys_core.instancing.similarity",
-    "lsys_core.svg.parse",
-    "lsys_core.grammar",
-)
+__all__ = ["INFER_PRELOAD", "Document"]
 
 
 class Document(QObject):
@@ -49,19 +44,14 @@ class Document(QObject):
     -------
     sceneChanged()
         A new input scene was loaded (or cleared).
-    textChanged(text)
-        The rules text changed (typing, undo, parameter change, inference).
-    grammarChanged(grammar)
-        A new valid grammar was parsed.
-    grammarError(error)
-        The text does not parse (a ``GrammarError``, with line/column if a syntax error),
-        or ``None`` when it parses again.
-    drawingChanged(drawing)
-        A new derivation is available.
-    settingsChanged(settings), randomizeChanged(randomize)
-        The inference settings / the randomization changed.
+    textChanged(text), grammarChanged(grammar), grammarError(error), drawingChanged(drawing)
+        See :class:`~app.rules_model.RulesModel`.
+    settingsChanged(settings)
+        The settings to show changed (applied, or restored after a cancelled run).
+    randomizeChanged(randomize)
+        The grammar's randomization changed.
     inferenceStarted(), inferenceProgress(stage, fraction), inferenceFinished()
-        Inference runs in the background; ``inferenceFinished`` also follows failures.
+        Inference runs in the background; ``inferenceFinished`` also follows failures and cancels.
     message(text)
         A readable error or note for the user.
     pathChanged(), gestureFinished()
@@ -82,53 +72,61 @@ class Document(QObject):
     gestureFinished = Signal()
 
     def __init__(self, parent: QObject | None = None, *, infer_compute: Any = None) -> None:
-        """Create an empty document.
-
-        ``infer_compute`` runs inference jobs (default: a worker process of its own, see
-        :data:`INFER_PRELOAD`); pass a shared :class:`~app.workers.ProcessCompute` or
-        :func:`~app.jobs.run_inference` itself (a worker thread) to override.
-        """
+        """Create an empty document (``infer_compute``: see :class:`InferenceControl`)."""
         super().__init__(parent)
         self.undo_stack = QUndoStack(self)
         self.scene: Any = None
         self.scene_path: str | None = None
         self.path: str | None = None
-        self.text = ""
-        self.grammar: Any = None
-        self.drawing: Any = None
-        self.error: LsysError | None = None
         self.result: Any = None
         self.settings: Any = core.default_settings()
-        self.randomize: Randomize | None = None
+        #: Settings of a re-inference in flight (shown in the panel), or None.
+        self.pending_settings: Any = None
         self._gesture: int | None = None
         self._gestures = itertools.count(1)
-        self._infer_purpose: tuple[str, Any] = ("none", None)
+        self._randomize: Any = None
 
-        self._parse_timer = QTimer(self)
-        self._parse_timer.setSingleShot(True)
-        self._parse_timer.setInterval(PARSE_DELAY_MS)
-        self._parse_timer.timeout.connect(self._parse_now)
-
-        self._own_process = infer_compute is None
-        if infer_compute is None:
-            infer_compute = ProcessCompute(run_inference, preload=INFER_PRELOAD)
-        self._infer_compute = infer_compute
-        self.inference = LatestRunner(
-            infer_compute, debounce_ms=INFER_DELAY_MS, name="lsys-inference", parent=self
-        )
+        self.rules = RulesModel(self)
+        for name in ("textChanged", "grammarChanged", "grammarError", "drawingChanged", "message"):
+            getattr(self.rules, name).connect(getattr(self, name))
+        self.rules.grammarChanged.connect(self._check_randomize)
+        self.inference = InferenceControl(infer_compute, self)
         self.inference.started.connect(self.inferenceStarted)
         self.inference.progress.connect(self.inferenceProgress)
-        self.inference.resultReady.connect(self._on_inferred)
+        self.inference.done.connect(self._on_inferred)
         self.inference.failed.connect(self._on_infer_failed)
-        self.deriver = LatestRunner(run_derive, name="lsys-derive", parent=self)
-        self.deriver.resultReady.connect(self._on_derived)
-        self.deriver.failed.connect(self._on_derive_failed)
+        self.inference.stopped.connect(self._on_infer_stopped)
 
     # -- queries --------------------------------------------------------------------------------
     @property
+    def text(self) -> str:
+        """The rules text (the source of truth)."""
+        return self.rules.text
+
+    @property
+    def grammar(self) -> Any:
+        """The last valid grammar of the text (None before the first)."""
+        return self.rules.grammar
+
+    @property
+    def drawing(self) -> Any:
+        """The derivation of the grammar (None before the first)."""
+        return self.rules.drawing
+
+    @property
+    def error(self) -> LsysError | None:
+        """Why the text does not parse, or None."""
+        return self.rules.error
+
+    @property
+    def randomize(self) -> Any:
+        """The grammar's randomization (its ``randomize`` line), or None."""
+        return self.grammar.randomize if self.grammar is not None else None
+
+    @property
     def busy(self) -> bool:
         """Whether inference, parsing or derivation is waiting or running."""
-        return self.inference.busy or self.deriver.busy or self._parse_timer.isActive()
+        return self.inference.busy or self.rules.busy
 
     @property
     def modified(self) -> bool:
@@ -137,13 +135,13 @@ class Document(QObject):
 
     @property
     def interactive(self) -> bool:
-        """Whether a gesture (slider drag) is in progress: draw drafts."""
+        """Whether a gesture (slider or handle drag) is in progress: draw drafts."""
         return self._gesture is not None
 
     @property
     def loading(self) -> bool:
         """Whether a file is being opened (or the input reloaded) in the background."""
-        return self._infer_purpose[0] in ("open", "reload")
+        return self.inference.kind in ("open", "reload")
 
     @property
     def can_infer(self) -> bool:
@@ -171,11 +169,25 @@ class Document(QObject):
                 return os.path.basename(p)
         return "Untitled"
 
+    # -- the command interface (see app.commands.EditTarget) ---------------------------------------
+    def apply_text(
+        self, text: str, *, grammar: Any = None, drawing: Any = None, typing: bool = False
+    ) -> None:
+        """Show ``text`` as the rules; a re-inference in flight is stale and stops."""
+        self.inference.supersede()
+        self.rules.apply_text(text, grammar=grammar, drawing=drawing, typing=typing)
+
+    def apply_settings(self, settings: Any) -> None:
+        """Record ``settings`` as those of the rules shown (no inference runs)."""
+        self.pending_settings = None
+        self.settings = settings
+        self.settingsChanged.emit(settings)
+
     # -- files ------------------------------------------------------------------------------------
     def open_svg(self, path: str) -> None:
         """Load an SVG and infer its grammar in the background (replaces the document when done)."""
-        self._infer_purpose = ("open", str(path))
-        self.inference.submit(InferRequest(None, self.settings, svg_path=str(path)), immediate=True)
+        request = InferRequest(None, self.settings, svg_path=str(path))
+        self.inference.submit(Purpose("open", path=str(path)), request)
 
     def open_lsys(self, path: str) -> None:
         """Open an .lsys rules file; the input scene is cleared.
@@ -186,18 +198,8 @@ class Document(QObject):
             If the file cannot be read (a parse error only marks the text).
         """
         text = core.read_text(path)
-        self.cancel_inference()
-        self._set_randomize_silently(None)
-        self.scene = None
-        self.scene_path = None
-        self.result = None
-        self.path = str(path)
-        self.grammar = None
-        self.drawing = None
-        self.undo_stack.clear()
-        self.sceneChanged.emit()
-        self._apply_text(text)
-        self.undo_stack.setClean()
+        self.inference.cancel()
+        self._replace(None, None, str(path), text)
         self.pathChanged.emit()
 
     def save(self, path: str | None = None) -> None:
@@ -211,12 +213,10 @@ class Document(QObject):
         self.pathChanged.emit()
 
     def restore(self, state: dict[str, Any]) -> None:
-        """Restore a recovered session (rules text, settings, randomization, file names)."""
-        self.cancel_inference()
+        """Restore a recovered session (rules text, settings, file names)."""
+        self.inference.cancel()
         self.undo_stack.clear()
-        self.settings = core.settings_from_dict(state.get("settings") or {})
-        self.settingsChanged.emit(self.settings)
-        self._set_randomize_silently(core.randomize_from_dict(state.get("randomize")))
+        self.apply_settings(core.settings_from_dict(state.get("settings") or {}))
         self.path = state.get("path")
         scene_path = state.get("scene_path")
         self.scene, self.scene_path, self.result = None, None, None
@@ -224,23 +224,31 @@ class Document(QObject):
         self.undo_stack.push(TextCommand(self, "Restore unsaved work", self.text, state.get("text", "")))
         self.pathChanged.emit()
         if scene_path and Path(scene_path).is_file():  # load the input in the background, no inference
-            self._infer_purpose = ("reload", scene_path)
             request = InferRequest(None, self.settings, svg_path=scene_path, load_only=True)
-            self.inference.submit(request, immediate=True)
+            self.inference.submit(Purpose("reload", path=scene_path), request)
 
     def snapshot(self) -> dict[str, Any]:
         """Return the state autosave writes (see :meth:`restore`)."""
         return {
             "text": self.text,
             "settings": dataclasses.asdict(self.settings),
-            "randomize": dataclasses.asdict(self.randomize) if self.randomize is not None else None,
             "path": self.path,
             "scene_path": self.scene_path,
         }
 
-    # -- edits (each pushes an undoable command) -------------------------------------------------------
+    def _replace(self, scene: Any, scene_path: str | None, path: str | None, text: str, **known: Any) -> None:
+        """Make a new document of ``text`` (``known``: its grammar and drawing); no undo history."""
+        self.scene, self.scene_path, self.path = scene, scene_path, path
+        self._restore_settings()
+        self.rules.clear()
+        self.undo_stack.clear()
+        self.sceneChanged.emit()
+        self.rules.apply_text(text, **known)
+        self.undo_stack.setClean()
+
+    # -- edits (each pushes one undoable command) ---------------------------------------------------
     def begin_gesture(self) -> None:
-        """Start a gesture (slider drag): its edits merge into one undo step and render as drafts."""
+        """Start a gesture (slider or handle drag): its edits merge into one undo step, drawn as drafts."""
         self._gesture = next(self._gestures)
 
     def end_gesture(self) -> None:
@@ -249,233 +257,196 @@ class Document(QObject):
             self._gesture = None
             self.gestureFinished.emit()
 
+    def merge_key(self, what: str) -> Any:
+        """Return the undo merge key of an edit ``what`` (None outside a gesture)."""
+        return (what, self._gesture) if self._gesture is not None else None
+
     def editable_grammar(self) -> Any:
         """Return the grammar of the current text for an edit, or None if the text does not parse.
 
         Text typed in the last moments is parsed first, so an edit never starts from a stale
         grammar (and never discards what was just typed).
         """
-        if self._parse_timer.isActive():
-            self._parse_timer.stop()
-            self._parse_now()
+        self.rules.flush()
         if self.error is not None:
             self.message.emit(f"Fix the rules first: {self.error}")
             return None
         return self.grammar
 
-    def _merge_key(self, what: str) -> Any:
-        return (what, self._gesture) if self._gesture is not None else None
-
     def edit_text(self, text: str) -> None:
         """Record typing in the rules editor (merged with the typing just before)."""
         if text != self.text:
-            self._supersede_inference()
             self.undo_stack.push(TextCommand(self, "Edit rules", self.text, text, merge_key="typing"))
 
     def set_param(self, key: str, value: float) -> None:
         """Change one numeric parameter of the rules; re-derives without re-inference."""
+        self.set_params({key: value}, f"Change {key}", f"param:{key}")
+
+    def set_params(self, values: dict[str, float], label: str, what: str | None = None) -> None:
+        """Change several parameters at once (one semantic parameter, a handle drag): one step."""
         current = self.editable_grammar()
         if current is None:
             return
         try:
-            grammar = core.set_param(current, key, value)
+            grammar = core.set_params(current, values)
         except LsysError as exc:
             self.message.emit(str(exc))
             return
-        self.apply_grammar(grammar, f"Change {key}", merge_key=self._merge_key(f"param:{key}"))
+        self.apply_grammar(grammar, label, merge_key=self.merge_key(what or label))
 
-    def apply_grammar(self, grammar: Any, label: str, *, merge_key: Any = None, drawing: Any = None) -> None:
-        """Replace the grammar by an edited one (undoable; the text is regenerated)."""
-        self._supersede_inference()
+    def apply_grammar(self, grammar: Any, label: str, *, merge_key: Any = None, drawing: Any = None) -> bool:
+        """Replace the grammar by an edited one (undoable; the text is regenerated).
+
+        Returns whether anything changed (an identical grammar pushes no step).
+        """
         text = core.format_grammar(grammar)
+        if text == self.text:
+            return False
         self.undo_stack.push(
             TextCommand(self, label, self.text, text, merge_key=merge_key, grammar=grammar, drawing=drawing)
         )
+        return True
 
     def set_settings(self, settings: Any) -> None:
-        """Change the inference settings; re-runs inference in the background (undoable)."""
-        if settings == self.settings or self.loading:
-            return
-        self.undo_stack.push(
-            SettingsCommand(self, self.settings, settings, self.text, merge_key=self._merge_key("settings"))
-        )
+        """Ask for new inference settings: re-infers in the background.
 
-    def set_randomize(self, randomize: Randomize | None) -> None:
-        """Set (or clear with None) the seeded perturbation of the derivation (undoable)."""
+        The undo step is pushed when the new rules arrive; until then the settings are
+        :attr:`pending_settings`, and cancelling restores :attr:`settings`.
+        """
+        if self.loading or settings == (self.pending_settings or self.settings):
+            return
+        if self.scene is None:  # nothing to infer from: the settings only matter for the next file
+            self.apply_settings(settings)
+            return
+        self.pending_settings = settings
+        request = InferRequest(self.scene, settings, self.randomize)
+        purpose = Purpose("settings", settings=settings, merge_key=self.merge_key("settings"))
+        self.inference.submit(purpose, request, immediate=False)
+
+    def set_randomize(self, randomize: Any) -> None:
+        """Set (or clear with None) the grammar's seeded perturbation: one undo step.
+
+        An inactive randomization (all amounts 0) clears it; setting the current one again
+        pushes nothing and says so.
+        """
+        self.rules.set_preview_randomize(None)
         if randomize is not None and not randomize.active:
             randomize = None
-        if randomize != self.randomize:
-            self.undo_stack.push(RandomizeCommand(self, self.randomize, randomize))
+        grammar = self.editable_grammar()
+        if grammar is None:
+            return
+        if randomize == grammar.randomize:
+            self.message.emit(
+                "Randomize: nothing changed (same seed and amounts)."
+                if randomize is not None
+                else "The rules are not randomized."
+            )
+            return
+        label = "Randomize" if randomize is not None else "Clear randomization"
+        self.apply_grammar(dataclasses.replace(grammar, randomize=randomize), label)
+
+    def preview_randomize(self, randomize: Any) -> None:
+        """Draw with ``randomize`` without changing the rules (None ends the preview)."""
+        self.rules.set_preview_randomize(randomize)
 
     def symmetrize(self) -> None:
         """Re-infer with relaxed tolerance in the background; applied as one undoable step."""
         if not self.can_infer:
             self.message.emit("Symmetrize needs an input SVG: open one first.")
             return
-        self._infer_purpose = ("symmetrize", None)
-        self.inference.submit(
-            InferRequest(self.scene, self.settings, self.randomize, symmetrize=True), immediate=True
-        )
+        request = InferRequest(self.scene, self.settings, self.randomize, symmetrize=True)
+        self.inference.submit(Purpose("symmetrize"), request)
 
     def reinfer(self) -> None:
-        """Run inference again with the current settings."""
+        """Run inference again with the current settings (one undo step if the rules change)."""
         if self.can_infer:
-            self._infer_purpose = ("reinfer", None)
-            self.inference.submit(InferRequest(self.scene, self.settings, self.randomize), immediate=True)
+            self.inference.submit(Purpose("reinfer"), InferRequest(self.scene, self.settings, self.randomize))
 
     def cancel_inference(self) -> None:
-        """Cancel the running inference; the document keeps its current rules."""
-        self.inference.cancel()
-        self._infer_purpose = ("none", None)
-        self.inferenceFinished.emit()
-
-    def warm_up(self) -> None:
-        """Start the inference process early, so the first inference does not wait for imports."""
-        start = getattr(self._infer_compute, "start", None)
-        if start is not None:
-            start()
-
-    def shutdown(self) -> None:
-        """Cancel all background work and wait for the worker threads to end."""
-        self._parse_timer.stop()
-        self.inference.shutdown()
-        self.deriver.shutdown()
-        if self._own_process:
-            self._infer_compute.close()
-
-    # -- appliers (called by commands and results) ---------------------------------------------------
-    def _apply_text(
-        self, text: str, *, grammar: Any = None, drawing: Any = None, typing: bool = False
-    ) -> None:
-        changed = text != self.text
-        self.text = text
-        if grammar is not None:  # derive first: the worker runs while the panels update
-            self._parse_timer.stop()
-            self._set_grammar(grammar, drawing)
-        if changed:
-            self.textChanged.emit(text)
-        if grammar is not None:
-            return
-        if typing:
-            self._parse_timer.start()
-        else:
-            self._parse_timer.stop()
-            self._parse_now()
-
-    def _parse_now(self) -> None:
-        try:
-            grammar = core.parse_grammar(self.text)
-        except GrammarError as exc:
-            self.error = exc
-            self.grammarError.emit(exc)
-            return
-        self._set_grammar(grammar, None)
-
-    def _set_grammar(self, grammar: Any, drawing: Any) -> None:
-        had_error = self.error is not None
-        self.error = None
-        changed = grammar != self.grammar
-        self.grammar = grammar
-        if drawing is not None:
-            self.deriver.cancel()
-            self._set_drawing(drawing)
-        else:
-            self.request_derive()  # before the panels update, so the worker starts at once
-        if had_error:
-            self.grammarError.emit(None)
-        if changed:
-            self.grammarChanged.emit(grammar)
+        """Cancel the running inference; the document keeps its rules and their settings."""
+        if self.inference.cancel() is None:
+            self.inferenceFinished.emit()
 
     def request_derive(self) -> None:
         """Derive the current grammar again in the background."""
-        if self.grammar is not None:
-            self.deriver.submit(DeriveRequest(self.grammar, self.randomize))
+        self.rules.request_derive()
 
-    def _set_drawing(self, drawing: Any) -> None:
-        self.drawing = drawing
-        self.drawingChanged.emit(drawing)
+    def warm_up(self) -> None:
+        """Start the inference process early, so the first inference does not wait for imports."""
+        self.inference.warm_up()
 
-    def _apply_settings(self, settings: Any, text: str | None, *, command: SettingsCommand | None) -> None:
-        self.settings = settings
-        self.settingsChanged.emit(settings)
-        if text is not None:
-            self._supersede_inference()
-            self._apply_text(text)
-        elif self.scene is not None:
-            self._infer_purpose = ("settings", command)
-            self.inference.submit(InferRequest(self.scene, settings, self.randomize))
+    def shutdown(self) -> None:
+        """Cancel all background work and wait for the worker threads to end."""
+        self.inference.shutdown()
+        self.rules.shutdown()
 
-    def _supersede_inference(self) -> None:
-        """Cancel an inference whose result would replace the rules the user is now editing.
+    # -- results of the background work -----------------------------------------------------------------
+    def _check_randomize(self, grammar: Any) -> None:
+        if grammar.randomize != self._randomize:
+            self._randomize = grammar.randomize
+            self.randomizeChanged.emit(self._randomize)
 
-        Opening a file or reloading the input scene is not cancelled: it is not about the rules.
-        """
-        if self._infer_purpose[0] in ("settings", "reinfer", "symmetrize"):
-            self.inference.cancel()
-            self._infer_purpose = ("none", None)
-            self.inferenceFinished.emit()
-
-    def _retarget_inference(self, old: SettingsCommand, new: SettingsCommand) -> None:
-        if self._infer_purpose == ("settings", old):
-            self._infer_purpose = ("settings", new)
-
-    def _set_randomize_silently(self, randomize: Randomize | None) -> None:
-        """Set the randomization of a new document (not an edit: nothing is derived here)."""
-        if randomize != self.randomize:
-            self.randomize = randomize
-            self.randomizeChanged.emit(randomize)
-
-    def _apply_randomize(self, randomize: Randomize | None) -> None:
-        self.randomize = randomize
-        self.randomizeChanged.emit(randomize)
-        self.request_derive()
-
-    # -- worker results --------------------------------------------------------------------------------
-    def _on_inferred(self, out: InferOutcome) -> None:
-        purpose, data = self._infer_purpose
-        self._infer_purpose = ("none", None)
-        if purpose == "reload":
-            self.scene, self.scene_path = out.scene, data
+    def _on_inferred(self, purpose: Purpose, out: InferOutcome) -> None:
+        kind = purpose.kind
+        if kind == "reload":
+            self.scene, self.scene_path = out.scene, purpose.path
             self.sceneChanged.emit()
-            self.inferenceFinished.emit()
-            return
-        self.result = out.result
-        if out.derive_error:
-            self.message.emit(out.derive_error)
-        if purpose == "open":
-            self.scene, self.scene_path, self.path = out.scene, data, None
-            self._set_randomize_silently(None)
-            self.undo_stack.clear()
-            self.grammar = None
-            self.sceneChanged.emit()
-            self._apply_text(out.text, grammar=out.result.grammar, drawing=out.drawing)
-            self.undo_stack.setClean()
+        elif kind == "open":
+            self.result = out.result
+            self._replace(out.scene, purpose.path, None, out.text, grammar=out.grammar, drawing=out.drawing)
             self.pathChanged.emit()
             warnings = getattr(out.scene, "warnings", ())
             if warnings:  # one line: the message bar shows only the latest message
                 self.message.emit("; ".join(warnings))
-        elif purpose == "symmetrize":
-            self.undo_stack.push(
-                TextCommand(
-                    self, "Symmetrize", self.text, out.text, grammar=out.result.grammar, drawing=out.drawing
-                )
+        elif kind == "settings":
+            self.result = out.result
+            command = SettingsCommand(
+                self,
+                self.settings,
+                purpose.settings,
+                self.text,
+                out.text,
+                merge_key=purpose.merge_key,
+                grammar=out.grammar,
+                drawing=out.drawing,
             )
+            self.undo_stack.push(command)
+            if out.text == command.old_text:
+                self.message.emit("The rules are the same with these settings.")
         else:
-            if purpose == "settings" and data is not None:
-                data.new_text = out.text
-            self._apply_text(out.text, grammar=out.result.grammar, drawing=out.drawing)
+            self._apply_inferred(kind, out)
+        if out.derive_error:
+            self.message.emit(out.derive_error)
         self.inferenceFinished.emit()
 
-    def _on_infer_failed(self, message: str) -> None:
-        purpose, data = self._infer_purpose
-        self._infer_purpose = ("none", None)
-        what = {"open": "Could not open", "reload": "Could not reload"}.get(purpose)
-        what = f"{what} {os.path.basename(data)}" if what else "Inference failed"
+    def _apply_inferred(self, kind: str, out: InferOutcome) -> None:
+        """Apply a Re-infer or Symmetrize result: one step, or none and a message if nothing changed."""
+        self.result = out.result
+        label = "Symmetrize" if kind == "symmetrize" else "Re-infer"
+        if out.text == self.text:
+            why = "the rules are already regular" if kind == "symmetrize" else "the rules are the same"
+            self.message.emit(f"{label}: nothing changed ({why}).")
+            return
+        self.undo_stack.push(
+            TextCommand(self, label, self.text, out.text, grammar=out.grammar, drawing=out.drawing)
+        )
+
+    def _on_infer_failed(self, purpose: Purpose, message: str) -> None:
+        what = {"open": "Could not open", "reload": "Could not reload"}.get(purpose.kind)
+        what = f"{what} {os.path.basename(purpose.path or '')}" if what else "Inference failed"
+        self._restore_settings()
         self.message.emit(f"{what}: {message}")
         self.inferenceFinished.emit()
 
-    def _on_derived(self, drawing: Any) -> None:
-        self._set_drawing(drawing)
+    def _on_infer_stopped(self, purpose: Purpose) -> None:
+        if self._restore_settings():
+            self.message.emit("Inference stopped: the settings are back to those of the rules shown.")
+        self.inferenceFinished.emit()
 
-    def _on_derive_failed(self, message: str) -> None:
-        self.message.emit(f"Derivation failed: {message}")
+    def _restore_settings(self) -> bool:
+        """Show the settings of the rules again after a run that brought none; return whether needed."""
+        if self.pending_settings is None:
+            return False
+        self.pending_settings = None
+        self.settingsChanged.emit(self.settings)
+        return True

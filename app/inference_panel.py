@@ -24,17 +24,10 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-__all__ = ["FIELDS", "InferencePanel"]
+from lsys_core.settings import SETTINGS, Setting
 
-#: ``(field, label, low, high, tooltip)`` of the settings the panel edits.
-FIELDS = (
-    ("wn", "w\u2099  repetition", 0.0, 1.0, "Weight of the number of repetitions in a cluster"),
-    ("wh", "w\u2095  proximity", 0.0, 1.0, "Weight of the distance between elements"),
-    ("wphi", "w\u03c6  similarity", 0.0, 1.0, "Weight of the similarity of the elements"),
-    ("wl", "w\u2097  length", 0.0, 1.0, "Weight of the length of the sequences"),
-    ("similarity", "Similarity threshold", 0.0, 1.0, "How similar two elements must be to share a symbol"),
-    ("tolerance", "Clustering tolerance", 0.1, 5.0, "Scales the clustering bandwidths"),
-)
+__all__ = ["InferencePanel"]
+
 _STEPS = 1000
 
 
@@ -43,13 +36,14 @@ class _SettingRow(QWidget):
 
     edited = Signal(str, float)
 
-    def __init__(self, name: str, low: float, high: float, parent: QWidget | None = None) -> None:
+    def __init__(self, spec: Setting, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.name, self.low, self.high = name, low, high
+        self.name, self.low, self.high = spec.name, spec.slider_low(), spec.slider_high
         self.slider = QSlider(Qt.Orientation.Horizontal, self)
         self.slider.setRange(0, _STEPS)
         self.spin = QDoubleSpinBox(self)
-        self.spin.setRange(low, high)
+        self.spin.setRange(self.low, spec.high)  # typed values may go beyond the slider
+        low, high = self.low, self.high
         self.spin.setDecimals(3)
         self.spin.setSingleStep((high - low) / 100)
         self.spin.setKeyboardTracking(False)
@@ -105,13 +99,14 @@ class InferencePanel(QWidget):
         self.rows: dict[str, _SettingRow] = {}
         weights = self.weights_box = QGroupBox("Cluster importance and similarity", self)
         form = QFormLayout(weights)
-        for name, label, low, high, tip in FIELDS:
-            row = _SettingRow(name, low, high, weights)
-            row.setToolTip(tip)
+        for spec in SETTINGS:
+            name = spec.name
+            row = _SettingRow(spec, weights)
+            row.setToolTip(f"{spec.help[0].upper()}{spec.help[1:]}, in {spec.range_text()}")
             row.edited.connect(self._on_edited)
             row.slider.sliderPressed.connect(self.dragStarted)
             row.slider.sliderReleased.connect(self.dragFinished)
-            form.addRow(QLabel(label, weights), row)
+            form.addRow(QLabel(spec.label, weights), row)
             self.rows[name] = row
         self._progress_box = QGroupBox("Progress", self)
         self._progress_form = QFormLayout(self._progress_box)
@@ -139,8 +134,10 @@ class InferencePanel(QWidget):
         names = {f.name for f in dataclasses.fields(settings)} if settings is not None else set()
         for name, row in self.rows.items():
             row.setEnabled(name in names)
-            if name in names:
+            if name in names and not row.slider.isSliderDown():  # never move a slider under the mouse
                 row.set_value(float(getattr(settings, name)))
+            elif name in names:
+                self._settings = dataclasses.replace(self._settings, **{name: row.spin.value()})
 
     def set_editable(self, editable: bool) -> None:
         """Enable the settings and Re-infer (there is an input to infer from); Cancel stays usable."""

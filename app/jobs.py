@@ -7,12 +7,13 @@ worker process (:class:`~app.workers.ProcessCompute`) loads no Qt GUI module.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from lsys_core.cancel import CancelToken, Progress
-from lsys_core.derive.derivation import Randomize, derive
+from lsys_core.derive.derivation import derive
 from lsys_core.errors import Cancelled, LsysError
+from lsys_core.grammar.model import Randomize
 
 from . import core
 
@@ -25,7 +26,8 @@ DERIVE_LIMIT = 1_000_000
 class InferRequest:
     """What an inference job needs, snapshot on the UI thread.
 
-    ``scene`` is None when ``svg_path`` is to be loaded first (opening a file).
+    ``scene`` is None when ``svg_path`` is to be loaded first (opening a file); ``randomize``
+    is kept in the inferred grammar (the document's current randomization).
     """
 
     scene: Any
@@ -39,10 +41,11 @@ class InferRequest:
 
 @dataclass(frozen=True)
 class InferOutcome:
-    """Result of an inference job: the inference result, its text and drawing.
+    """Result of an inference job: the inference result, the grammar, its text and drawing.
 
     ``scene`` is the loaded scene when the request asked to load a file (else None: the
-    requester has it already, and it need not travel back from a worker process).
+    requester has it already, and it need not travel back from a worker process).  ``grammar``
+    is the inferred grammar with the request's randomization.
     """
 
     scene: Any
@@ -50,11 +53,12 @@ class InferOutcome:
     text: str
     drawing: Any
     derive_error: str | None = None
+    grammar: Any = None
 
 
 @dataclass(frozen=True)
 class DeriveRequest:
-    """What a derivation job needs: the grammar and how to perturb it."""
+    """What a derivation job needs: the grammar and how to perturb it (None: as the grammar says)."""
 
     grammar: Any
     randomize: Randomize | None = None
@@ -68,16 +72,17 @@ def run_inference(request: InferRequest, cancel: CancelToken, progress: Progress
         return InferOutcome(scene, None, "", None)
     run = core.symmetrize if request.symmetrize else core.infer
     result = run(scene, request.settings, cancel=cancel, progress=progress)
-    text = core.format_grammar(result.grammar)
+    grammar = replace(result.grammar, randomize=request.randomize)
+    text = core.format_grammar(grammar)
     try:
-        drawing = derive(result.grammar, limit=request.limit, randomize=request.randomize, cancel=cancel)
+        drawing = derive(grammar, limit=request.limit, cancel=cancel)
     except Cancelled:
         raise
     except LsysError as exc:  # the rules are still worth showing
         drawing, error = None, str(exc)
     else:
         error = None
-    return InferOutcome(scene if request.scene is None else None, result, text, drawing, error)
+    return InferOutcome(scene if request.scene is None else None, result, text, drawing, error, grammar)
 
 
 def run_derive(request: DeriveRequest, cancel: CancelToken, progress: Progress) -> Any:

@@ -470,13 +470,15 @@ class MainWindow(QMainWindow):
 
     # -- actions ---------------------------------------------------------------------------------------
     def randomize_dialog(self) -> None:
-        """Show the randomize dialog; Cancel restores the previous randomization."""
+        """Show the randomize dialog: Apply and Re-roll preview, OK is one undo step, Cancel none."""
+        if self.doc.editable_grammar() is None:
+            return
         dialog = RandomizeDialog(self.doc.randomize, self)
-        dialog.applied.connect(self.doc.set_randomize)
+        dialog.applied.connect(self.doc.preview_randomize)
         if dialog.exec():
             self.doc.set_randomize(dialog.value())
         else:
-            self.doc.set_randomize(dialog.initial)
+            self.doc.preview_randomize(None)
 
     def replace_dialog(self) -> None:
         """Show the replace-symbol dialog and apply the choice."""

@@ -22,6 +22,8 @@ from lsys_core.hierarchy.rules import Hierarchy, Tolerance, Weights, build_hiera
 from lsys_core.instancing.fidelity import split_unfaithful
 from lsys_core.instancing.model import Instancing
 from lsys_core.instancing.orientation import unwrap_symmetric
+from lsys_core.settings import SETTINGS, setting
+from lsys_core.settings import check as check_setting
 from lsys_core.svg.model import Scene
 
 __all__ = ["InferenceResult", "InferenceSettings", "infer", "symmetrize"]
@@ -34,9 +36,6 @@ INFER_ERROR = 0.004
 #: Largest deviation (relative to the scene's diagonal) of an element from the terminal
 #: drawn in its place; elements farther from their group's shape get a terminal of their own.
 SHAPE_ERROR = 0.002
-#: Smallest clustering tolerance: below it no two transformations share a cluster anyway, and
-#: the bandwidth-scaled coordinates of a large scene would overflow the clustering's cell grid.
-MIN_TOLERANCE = 1e-6
 #: Scenes with more elements than this try fewer relaxed tolerances (see :func:`_factors`).
 LARGE_SCENE = 1000
 #: A relaxed grammar may deviate up to this much if it needs at most :data:`JITTER_GAIN`
@@ -64,12 +63,12 @@ class InferenceSettings:
         Neighbours per node in the transformation spaces.
     """
 
-    wn: float = Weights.wn
-    wh: float = Weights.wh
-    wphi: float = Weights.wphi
-    wl: float = Weights.wl
-    similarity: float = 0.6
-    tolerance: float = 1.0
+    wn: float = setting("wn").default
+    wh: float = setting("wh").default
+    wphi: float = setting("wphi").default
+    wl: float = setting("wl").default
+    similarity: float = setting("similarity").default
+    tolerance: float = setting("tolerance").default
     neighbours: int = 24
 
     def relaxed(self, factor: float = RELAXED) -> InferenceSettings:
@@ -77,15 +76,15 @@ class InferenceSettings:
         return replace(self, tolerance=self.tolerance * factor)
 
     def validated(self) -> InferenceSettings:
-        """Return the settings, raising :class:`InferenceError` for values out of range."""
-        for name in ("wn", "wh", "wphi", "wl"):
-            v = getattr(self, name)
-            if not (0.0 <= v <= 1.0):
-                raise InferenceError(f"weight {name} must be in [0, 1], got {v}")
-        if not (0.0 < self.similarity <= 1.0):
-            raise InferenceError(f"similarity threshold must be in (0, 1], got {self.similarity}")
-        if not (MIN_TOLERANCE <= self.tolerance <= 1000.0):
-            raise InferenceError(f"tolerance must be in [{MIN_TOLERANCE:g}, 1000], got {self.tolerance:g}")
+        """Return the settings, raising :class:`InferenceError` for values out of range.
+
+        The ranges are those of :data:`lsys_core.settings.SETTINGS` (which the editor's sliders
+        and the CLI's help show too).
+        """
+        for s in SETTINGS:
+            problem = check_setting(s.name, float(getattr(self, s.name)))
+            if problem is not None:
+                raise InferenceError(problem)
         return self
 
 

@@ -31,17 +31,13 @@ def _common() -> argparse.ArgumentParser:
 
 
 def _weights(p: argparse.ArgumentParser) -> None:
+    from lsys_core.settings import SETTINGS
+
     g = p.add_argument_group("inference settings")
-    g.add_argument("--wn", type=float, help="weight of repetition count n, in [0, 1]")
-    g.add_argument("--wh", type=float, help="weight of proximity h, in [0, 1]")
-    g.add_argument("--wphi", type=float, help="weight of similarity φ, in [0, 1]")
-    g.add_argument("--wl", type=float, help="weight of sequence length l, in [0, 1]")
-    g.add_argument(
-        "--similarity", type=float, help="similarity threshold φ for shared terminals (default 0.6)"
-    )
-    g.add_argument(
-        "--tolerance", type=float, help="factor on the clustering bandwidths, in [1e-6, 1000] (default 1)"
-    )
+    for s in SETTINGS:
+        g.add_argument(
+            f"--{s.name}", type=float, help=f"{s.help}, in {s.range_text()} (default {s.default:g})"
+        )
 
 
 def _png(p: argparse.ArgumentParser) -> None:

@@ -110,8 +110,9 @@ def _load_rules(path: str):
 
 def _settings(args: argparse.Namespace):
     from lsys_core.pipeline import InferenceSettings
+    from lsys_core.settings import SETTINGS
 
-    kw = {k: getattr(args, k) for k in ("wn", "wh", "wphi", "wl", "similarity", "tolerance")}
+    kw = {s.name: getattr(args, s.name) for s in SETTINGS}
     return InferenceSettings(**{k: v for k, v in kw.items() if v is not None}).validated()
 
 

@@ -15,7 +15,7 @@ identity rule ``r0`` leaves it in the string, and a non-terminal has no interpre
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -23,31 +23,11 @@ from lsys_core.cancel import CancelToken, check
 from lsys_core.derive.model import Drawing
 from lsys_core.errors import GrammarError, LimitError
 from lsys_core.geometry.transforms import DEG
-from lsys_core.grammar.model import COND_EQ0, COND_GT0, Case, Grammar, Pop, Push, Symbol, Turtle
+from lsys_core.grammar.model import COND_EQ0, COND_GT0, Case, Grammar, Pop, Push, Randomize, Symbol, Turtle
 
 __all__ = ["DEFAULT_LIMIT", "Randomize", "derive"]
 
 DEFAULT_LIMIT = 1_000_000
-
-
-@dataclass(frozen=True)
-class Randomize:
-    """Per-application random perturbation of the rules' turtle commands.
-
-    Every application of ``+``/``-`` gets ``U(-angle, angle)`` degrees added, every ``f``
-    is multiplied by ``1 + U(-distance, distance)`` and every ``*`` by ``1 + U(-scale, scale)``.
-    The axiom is not perturbed.  The same seed gives the same drawing.
-    """
-
-    angle: float = 0.0
-    distance: float = 0.0
-    scale: float = 0.0
-    seed: int = 0
-
-    @property
-    def active(self) -> bool:
-        """Whether any amount is non-zero."""
-        return bool(self.angle or self.distance or self.scale)
 
 
 # Compiled body ops: ("t", op, c0, cd) turtle, ("[",) push, ("]",) pop,
@@ -234,7 +214,8 @@ def derive(
         Maximum number of terminal instances; exceeding it raises :class:`LimitError`
         naming the rule, before the arrays are allocated.
     randomize : Randomize, optional
-        Seeded random perturbation of every rule application.
+        Seeded random perturbation (see :class:`~lsys_core.grammar.model.Randomize`); None
+        uses the grammar's own (its ``randomize`` line), an inactive one draws without noise.
     cancel : CancelToken, optional
         Checked between batches.
 
@@ -248,6 +229,11 @@ def derive(
 
 
 def _derive(grammar: Grammar, limit: int, randomize: Randomize | None, cancel: CancelToken | None) -> Drawing:
+    if randomize is None:
+        randomize = grammar.randomize
+    if randomize is not None and not randomize.active:
+        randomize = None
+    per_instance = randomize is not None and randomize.jitter == "instance"
     compiled, _, _ = _compile(grammar)
     emitter = _Emitter(limit)
     work_budget = 4 * max(limit, 1000)
@@ -269,7 +255,7 @@ def _derive(grammar: Grammar, limit: int, randomize: Randomize | None, cancel: C
             order.append(target)
         pending[target].append((m, a, b))
 
-    interp = _Interpreter(randomize, emitter, pending, limit)
+    interp = _Interpreter(None if per_instance else randomize, emitter, pending, limit)
 
     def emit(draws, rule: int, where: str, a_base=None, b_base=None) -> None:
         for term, a, b in draws:
@@ -316,7 +302,10 @@ def _derive(grammar: Grammar, limit: int, randomize: Randomize | None, cancel: C
                     push(target, np.asarray(mm, np.int64), ca, cb)
                 continue
             _unroll(interp, emit, push, rule, r, ci, case, ms, as_, bs, where, work_budget - work)
-    return _collect(grammar, emitter)
+    drawing = _collect(grammar, emitter)
+    if per_instance and randomize is not None:
+        return _jitter_instances(drawing, randomize)
+    return drawing
 
 
 def _check_finite(a: np.ndarray, b: np.ndarray, where: str) -> None:
@@ -404,3 +393,34 @@ def _collect(grammar: Grammar, emitter: _Emitter) -> Drawing:
         b = np.zeros(0, complex)
         rule = np.zeros(0, np.int32)
     return Drawing(grammar.terminals, sym, a, b, rule, grammar.viewbox, grammar.size)
+
+
+def _jitter_instances(drawing: Drawing, rnd: Randomize) -> Drawing:
+    """Perturb every instance drawn by a rule on its own (``jitter="instance"``, see ``Randomize``)."""
+    sel = np.flatnonzero(drawing.rule >= 0)
+    if sel.size == 0:
+        return drawing
+    rng = np.random.default_rng(rnd.seed)
+    a, b = drawing.a.copy(), drawing.b.copy()
+    n = sel.size
+    turn = np.exp(1j * DEG * rng.uniform(-rnd.angle, rnd.angle, n)) if rnd.angle else 1.0
+    grow = 1.0 + rng.uniform(-rnd.scale, rnd.scale, n) if rnd.scale else 1.0
+    if rnd.distance:
+        gap = _nearest_gap(b)[sel]
+        heading = a[sel] / np.where(np.abs(a[sel]) > 0, np.abs(a[sel]), 1.0)
+        offset = rng.uniform(-1.0, 1.0, n) + 1j * rng.uniform(-1.0, 1.0, n)
+        b[sel] = b[sel] + rnd.distance * gap * heading * offset
+    a[sel] = a[sel] * turn * grow
+    return replace(drawing, a=a, b=b)
+
+
+def _nearest_gap(points: np.ndarray) -> np.ndarray:
+    """Return each point's distance to its nearest other point (0 when it is alone)."""
+    if points.size < 2:
+        return np.zeros(points.size)
+    from scipy.spatial import cKDTree
+
+    xy = np.column_stack([points.real, points.imag])
+    dist, _ = cKDTree(xy).query(xy, k=2)
+    gap = dist[:, 1]
+    return np.where(np.isfinite(gap), gap, 0.0)

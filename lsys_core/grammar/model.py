@@ -32,6 +32,7 @@ __all__ = [
     "Module",
     "Pop",
     "Push",
+    "Randomize",
     "Rule",
     "Symbol",
     "Terminal",
@@ -45,6 +46,8 @@ COND_EQ0: Final = "m == 0"
 CaseCondition = Literal["m > 0", "m == 0"]
 Condition = CaseCondition | None
 TurtleOp = Literal["f", "+", "-", "*"]
+Jitter = Literal["cumulative", "instance"]
+JITTERS: tuple[Jitter, ...] = ("cumulative", "instance")
 
 
 @dataclass(frozen=True)
@@ -139,6 +142,32 @@ class Verbatim:
 
 
 @dataclass(frozen=True)
+class Randomize:
+    """Seeded random perturbation of a derivation (the ``randomize`` line of an ``.lsys`` file).
+
+    ``jitter="cumulative"``: every application of ``+``/``-`` in a rule gets ``U(-angle, angle)``
+    degrees added, every ``f`` is multiplied by ``1 + U(-distance, distance)`` and every ``*`` by
+    ``1 + U(-scale, scale)``; the turtle carries each perturbation on, so it accumulates along a
+    sequence (a row drifts).  ``jitter="instance"``: every instance drawn by a rule is turned by
+    ``U(-angle, angle)`` degrees about its origin, scaled by ``1 + U(-scale, scale)`` and moved
+    by up to ``distance`` times the gap to its nearest neighbour along and across its heading;
+    the next instance is placed as without noise.  The axiom is not perturbed.  The same seed
+    gives the same drawing.
+    """
+
+    angle: float = 0.0
+    distance: float = 0.0
+    scale: float = 0.0
+    seed: int = 0
+    jitter: Jitter = "cumulative"
+
+    @property
+    def active(self) -> bool:
+        """Whether any amount is non-zero."""
+        return bool(self.angle or self.distance or self.scale)
+
+
+@dataclass(frozen=True)
 class Grammar:
     """A complete L-system: terminals, rules, axiom and the SVG canvas it draws on.
 
@@ -157,6 +186,8 @@ class Grammar:
     defs: str = ""
     #: Content carried through verbatim, drawn at its place in the paint order.
     verbatim: tuple[Verbatim, ...] = ()
+    #: The random perturbation the derivation applies (None: none).
+    randomize: Randomize | None = None
 
     def terminal(self, name: str) -> Terminal | None:
         """Return the terminal called ``name``, or None."""

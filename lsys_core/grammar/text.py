@@ -25,6 +25,7 @@ from lsys_core.errors import GrammarSyntaxError
 from lsys_core.grammar.model import (
     COND_EQ0,
     COND_GT0,
+    JITTERS,
     Case,
     CaseCondition,
     Count,
@@ -33,6 +34,7 @@ from lsys_core.grammar.model import (
     Module,
     Pop,
     Push,
+    Randomize,
     Rule,
     Symbol,
     Terminal,
@@ -43,8 +45,14 @@ from lsys_core.grammar.validate import KEYWORDS, RESERVED, Problem, count_text, 
 
 __all__ = ["FORMAT_VERSION", "format_grammar", "parse_grammar"]
 
-FORMAT_VERSION = 1
-"""Version written in the ``lsys`` header and the only one this module reads."""
+FORMAT_VERSION = 2
+"""The newest format version: version 2 adds the ``randomize`` line to version 1.
+
+A file is written in the oldest version that can express it (``lsys 1`` unless it has a
+``randomize`` line), so files without one stay readable by version-1 readers."""
+_VERSIONS = ("1", "2")
+#: Seeds are stored as written; beyond this they would not survive a round trip through floats.
+SEED_LIMIT = 2**53
 
 _TOKEN = re.compile(
     r"""
@@ -175,6 +183,9 @@ class _State:
     size: tuple[str, str] | None = None
     canvas_at: _Tok | None = None
     axiom_at: _Tok | None = None
+    version: int = 1
+    randomize: Randomize | None = None
+    randomize_at: _Tok | None = None
     places: dict[tuple, tuple[int, int]] = field(default_factory=dict)
 
 
@@ -239,11 +250,12 @@ class _Line:
         tok = self.peek()
         if tok.kind != "num":
             raise _fail(f"expected a format version after 'lsys', got {tok.shown()}", tok)
-        if tok.text != str(FORMAT_VERSION):
+        if tok.text not in _VERSIONS:
             raise _fail(
-                f"unsupported format version {tok.text}: this program reads version {FORMAT_VERSION}", tok
+                f"unsupported format version {tok.text}: this program reads versions 1 to {FORMAT_VERSION}",
+                tok,
             )
-        self.take()
+        self.st.version = int(self.take().text)
         self.end()
 
     def statement(self) -> None:
@@ -251,6 +263,8 @@ class _Line:
         tok = self.peek()
         if tok.kind == "name" and tok.text in ("canvas", "terminal", "axiom"):
             getattr(self, tok.text)()
+        elif tok.kind == "name" and tok.text == "randomize" and self.toks[self.i + 1].kind == "name":
+            self.randomize()  # a name follows: not a rule called randomize
         elif tok.kind == "name" and tok.text == "lsys":
             raise _fail("duplicate header 'lsys'", tok)
         elif tok.kind == "name" and tok.text not in KEYWORDS:
@@ -279,6 +293,36 @@ class _Line:
                 self.st.size = (self.string("the width"), self.string("the height"))
         if not seen:
             raise _fail(f"expected 'viewbox' or 'size', got {self.peek().shown()}", self.peek())
+
+    def randomize(self) -> None:
+        """Read ``randomize [angle A] [distance D] [scale S] [seed N] [jitter instance|cumulative]``."""
+        kw = self.take()
+        if self.st.version < 2:
+            raise _fail("the randomize line needs format version 2: write 'lsys 2' as the header", kw)
+        if self.st.randomize_at is not None:
+            raise _fail(f"duplicate randomize line (first on line {self.st.randomize_at.line})", kw)
+        self.st.randomize_at = kw
+        opts: dict[str, float | str] = {}
+        names = ("angle", "distance", "scale", "seed", "jitter")
+        while self.peek().kind == "name" and self.peek().text in names:
+            opt = self.take()
+            if opt.text in opts:
+                raise _fail(f"duplicate '{opt.text}'", opt)
+            tok = self.peek()
+            if opt.text == "jitter":
+                if tok.kind != "name" or tok.text not in JITTERS:
+                    raise _fail(f"expected 'instance' or 'cumulative' after 'jitter', got {tok.shown()}", tok)
+                opts["jitter"] = self.take().text
+                continue
+            value = self.signed_number()
+            if value < 0 or (opt.text == "seed" and (not value.is_integer() or value >= SEED_LIMIT)):
+                what = "a whole number >= 0" if opt.text == "seed" else "a number >= 0"
+                raise _fail(f"{opt.text} must be {what}, got {value:g}", tok)
+            opts[opt.text] = value
+        if not opts:
+            raise _fail(f"expected one of {', '.join(names)}, got {self.peek().shown()}", self.peek())
+        seed = int(opts.pop("seed", 0))
+        self.st.randomize = Randomize(seed=seed, **opts)  # type: ignore[arg-type]
 
     def terminal(self) -> None:
         """Read ``terminal NAME "PATH" [style "CSS"] [mirror NAME]``."""
@@ -530,6 +574,7 @@ def parse_grammar(text: str, *, check_paths: bool = False) -> Grammar:
         axiom=st.axiom,
         viewbox=st.viewbox,
         size=st.size,
+        randomize=st.randomize,
         comments=tuple(c for line, c in comments if len(lines) < 2 or line < lines[1][0].line),
     )
     problems = find_problems(g)
@@ -577,7 +622,7 @@ def format_grammar(g: Grammar) -> str:
         Header, comments, canvas, terminals, axiom, then one line per production, each
         line ending with a newline.  Formatting parsed text again gives the same text.
     """
-    out = [f"lsys {FORMAT_VERSION}"]
+    out = [f"lsys {1 if g.randomize is None else 2}"]
     for c in g.comments:
         out += [f"# {part}".rstrip() for part in (c.splitlines() or [""])]
     canvas = []
@@ -587,6 +632,8 @@ def format_grammar(g: Grammar) -> str:
         canvas.append(f"size {_quote(g.size[0])} {_quote(g.size[1])}")
     if canvas:
         out.append("canvas " + " ".join(canvas))
+    if g.randomize is not None:
+        out.append(_randomize_line(g.randomize))
     for t in g.terminals:
         line = f"terminal {t.name} {_quote(t.path)}"
         if t.style:
@@ -601,6 +648,12 @@ def format_grammar(g: Grammar) -> str:
             cond = f": {case.cond}" if case.cond is not None else ""
             out.append(f"{head}{cond} -> {_body(case.body)}")
     return "\n".join(out) + "\n"
+
+
+def _randomize_line(r: Randomize) -> str:
+    """Return the ``randomize`` line: the non-zero amounts, the seed and the jitter."""
+    amounts = [f"{k} {_num(getattr(r, k))}" for k in ("angle", "distance", "scale") if getattr(r, k)]
+    return " ".join(["randomize", *amounts, f"seed {int(r.seed)}", f"jitter {r.jitter}"])
 
 
 def _body(body: tuple[Module, ...]) -> str:

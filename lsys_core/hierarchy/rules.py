@@ -29,6 +29,7 @@ from lsys_core.hierarchy.emit import const_t, emit
 from lsys_core.hierarchy.nodes import Nodes
 from lsys_core.hierarchy.spaces import pair_space
 from lsys_core.hierarchy.symbols import SymbolTable
+from lsys_core.settings import setting
 
 __all__ = ["Hierarchy", "Tolerance", "Weights", "build_hierarchy"]
 
@@ -45,10 +46,10 @@ WEAK_COVER = 0.05
 class Weights:
     """User weights of the cluster importance ``w = wn·n + wh·h + wφ·φ + wl·l``, each in [0, 1]."""
 
-    wn: float = 0.3
-    wh: float = 1.0
-    wphi: float = 0.3
-    wl: float = 0.3
+    wn: float = setting("wn").default
+    wh: float = setting("wh").default
+    wphi: float = setting("wphi").default
+    wl: float = setting("wl").default
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ from PySide6.QtGui import QDropEvent, QKeySequence, QTextCursor
 from PySide6.QtWidgets import QMessageBox
 
 from app import core
-from lsys_core.derive.derivation import Randomize
+from lsys_core.grammar.model import Randomize
 
 
 def _open(window, path, wait_idle):
@@ -79,7 +79,7 @@ def test_param_slider_drag_rederives_without_inference_as_one_undo_step(window, 
     row.slider.setSliderDown(True)  # press
     for pos in range(row.slider.value() + 10, row.slider.value() + 60, 10):
         row.slider.setValue(pos)
-        qtbot.waitUntil(lambda: not doc.deriver.busy, timeout=120_000)
+        qtbot.waitUntil(lambda: not doc.rules.deriver.busy, timeout=120_000)
         qtbot.wait(5)
     assert doc.interactive
     row.slider.setSliderDown(False)  # release
@@ -174,12 +174,13 @@ def test_randomize_dialog_reroll_applies_a_new_seed(window, helix_lsys, wait_idl
 
     _open(window, helix_lsys, wait_idle)
     dialog = RandomizeDialog(None, window)
-    dialog.applied.connect(window.doc.set_randomize)
+    dialog.applied.connect(window.doc.preview_randomize)
     dialog.reroll()
-    first = window.doc.randomize
+    first = window.doc.rules.preview_randomize
     dialog.reroll()
-    assert window.doc.randomize.seed != first.seed
-    assert window.doc.randomize.angle == pytest.approx(dialog.angle.value())
+    shown = window.doc.rules.preview_randomize
+    assert shown.seed != first.seed and shown.angle == pytest.approx(dialog.angle.value())
+    assert window.doc.randomize is None and window.doc.undo_stack.count() == 0  # a preview only
     dialog.close()
 
 

@@ -29,7 +29,7 @@ def _compare():
 def _spy_inference(doc):
     """Wrap the document's inference compute to record the thread, settings and fate of each job."""
     jobs = []
-    compute = doc.inference._compute
+    compute = doc.inference.runner._compute
 
     def spy(request, cancel, progress):
         job = {
@@ -47,7 +47,7 @@ def _spy_inference(doc):
         job["end"] = "done"
         return out
 
-    doc.inference._compute = spy
+    doc.inference.runner._compute = spy
     return jobs
 
 
@@ -79,7 +79,7 @@ def test_weight_slider_cancels_running_inference_and_applies_newest(window, corp
     doc = window.doc
     first_text = doc.text
     jobs = []
-    compute = doc.inference._compute
+    compute = doc.inference.runner._compute
 
     def slow(request, cancel, progress):  # long enough for the next slider move to catch it running
         jobs.append((request.settings, cancel))
@@ -88,7 +88,7 @@ def test_weight_slider_cancels_running_inference_and_applies_newest(window, corp
             time.sleep(0.005)
         return compute(request, cancel, progress)
 
-    doc.inference._compute = slow
+    doc.inference.runner._compute = slow
     row = window.inference_panel.rows["wh"]
     row.slider.setSliderDown(True)
     row.slider.setValue(row.slider.value() - 100)
@@ -114,7 +114,7 @@ def test_cancel_button_stops_inference_and_keeps_rules(window, corpus, qtbot, wa
     wait_idle(window)
     doc = window.doc
     text = doc.text
-    compute = doc.inference._compute
+    compute = doc.inference.runner._compute
 
     def slow(request, cancel, progress):
         for _ in range(400):
@@ -122,9 +122,9 @@ def test_cancel_button_stops_inference_and_keeps_rules(window, corpus, qtbot, wa
             time.sleep(0.005)
         return compute(request, cancel, progress)
 
-    doc.inference._compute = slow
+    doc.inference.runner._compute = slow
     window.inference_panel.reinfer_button.click()
-    qtbot.waitUntil(lambda: doc.inference.running, timeout=120_000)
+    qtbot.waitUntil(lambda: doc.inference.runner.running, timeout=120_000)
     assert window.inference_panel.cancel_button.isEnabled()
     window.inference_panel.cancel_button.click()
     wait_idle(window)
@@ -132,18 +132,36 @@ def test_cancel_button_stops_inference_and_keeps_rules(window, corpus, qtbot, wa
 
 
 def test_symmetrize_is_one_undoable_step(window, corpus, wait_idle):
-    path = corpus("facade_jitter.svg")
+    path = corpus("noisy_sequence.svg")  # symmetrize regularises its noisy rules
     window.open_path(str(path))
     wait_idle(window)
     doc = window.doc
     before = doc.text
     window.act_symmetrize.trigger()
     wait_idle(window)
+    assert doc.text != before
     assert doc.undo_stack.count() == 1 and doc.undo_stack.undoText() == "Symmetrize"
     assert doc.scene is not None and doc.drawing is not None
     doc.undo_stack.undo()
     wait_idle(window)
     assert doc.text == before
+
+
+def test_symmetrize_and_reinfer_that_change_nothing_push_no_step_and_say_why(window, corpus, wait_idle):
+    window.open_path(str(corpus("facade_jitter.svg")))  # already as regular as symmetrize makes it
+    wait_idle(window)
+    doc = window.doc
+    before = doc.text
+    messages = []
+    doc.message.connect(messages.append)
+    window.act_symmetrize.trigger()
+    wait_idle(window)
+    assert doc.text == before and doc.undo_stack.count() == 0
+    assert messages and "Symmetrize: nothing changed" in messages[-1]
+    window.inference_panel.reinfer_button.click()
+    wait_idle(window)
+    assert doc.text == before and doc.undo_stack.count() == 0
+    assert "Re-infer: nothing changed" in messages[-1]
 
 
 def test_export_svg_reproduces_input(window, corpus, tmp_path, wait_idle):
