@@ -16,6 +16,7 @@ $(STAMP): pyproject.toml | $(BIN)/python
 	@touch $(STAMP)
 
 run: $(STAMP)
+	@$(BIN)/python -m lsys_editor.syscheck
 	$(BIN)/lsys-editor $(EXAMPLE)
 
 lint: $(STAMP)

@@ -147,6 +147,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     multiprocessing.freeze_support()  # the inference worker process of a frozen build
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
+    from .syscheck import problem
+
+    missing = None if _qt_running() else problem()
+    if missing:  # Qt would abort naming only the first missing library
+        print(f"lsys-editor: {missing}", file=sys.stderr)
+        return 1
     from PySide6.QtCore import QCoreApplication, QSettings
     from PySide6.QtWidgets import QApplication
 
@@ -180,6 +186,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         return app.exec()
     finally:
         window.shutdown()
+
+
+def _qt_running() -> bool:
+    """Whether a QApplication already runs in this process (tests): its plugin has loaded."""
+    if "PySide6.QtWidgets" not in sys.modules:
+        return False
+    from PySide6.QtWidgets import QApplication
+
+    return QApplication.instance() is not None
 
 
 def _set_identity(app) -> None:

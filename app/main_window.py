@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import QSettings, Qt, QTimer
-from PySide6.QtGui import QAction, QActionGroup, QCloseEvent, QKeySequence
+from PySide6.QtGui import QCloseEvent
 from PySide6.QtWidgets import (
     QDockWidget,
     QFileDialog,
@@ -26,6 +26,7 @@ from PySide6.QtWidgets import (
 from lsys_core.errors import LsysError
 
 from . import core
+from .actions import create_actions, create_menus, redo_keys, undo_keys
 from .canvas import Canvas
 from .dialogs import RandomizeDialog, ReplaceDialog
 from .document import Document
@@ -34,7 +35,6 @@ from .message_bar import MessageBar
 from .params_panel import ParamsPanel
 from .recent_files import RecentFiles
 from .recovery import Recovery
-from .resources import examples
 from .rules_panel import RulesPanel
 
 __all__ = ["MainWindow"]
@@ -105,8 +105,8 @@ class MainWindow(QMainWindow):
         for label in self._status_labels.values():
             self.statusBar().addPermanentWidget(label)
 
-        self._create_actions()
-        self._create_menus()
+        create_actions(self)
+        create_menus(self, (self.rules_dock, self.params_dock, self.inference_dock))
         self._connect()
         self.inference_panel.set_settings(self.doc.settings)
         self._update_actions()
@@ -131,118 +131,6 @@ class MainWindow(QMainWindow):
         self.addDockWidget(area, dock)
         return dock
 
-    def _action(self, text: str, slot, shortcut: Any = None, tip: str = "") -> QAction:
-        action = QAction(text, self)
-        if shortcut is not None:
-            action.setShortcut(QKeySequence(shortcut))
-        if tip:
-            action.setStatusTip(tip)
-        action.triggered.connect(slot)
-        return action
-
-    def _create_actions(self) -> None:
-        K = QKeySequence.StandardKey
-        self.act_open = self._action("&Open…", self.open_dialog, K.Open, "Open an SVG or .lsys file")
-        self.act_save = self._action("&Save", self.save, K.Save, "Save the rules as .lsys")
-        self.act_save_as = self._action("Save &As…", self.save_as, K.SaveAs)
-        self.act_export_svg = self._action("Export S&VG…", self.export_svg_dialog, "Ctrl+E")
-        self.act_export_png = self._action("Export &PNG…", self.export_png_dialog, "Ctrl+Shift+E")
-        self.act_quit = self._action("&Quit", self.close, K.Quit)
-        self.act_undo = self.doc.undo_stack.createUndoAction(self, "&Undo")
-        self.act_undo.setShortcut(QKeySequence(K.Undo))
-        self.act_redo = self.doc.undo_stack.createRedoAction(self, "&Redo")
-        self.act_redo.setShortcuts([QKeySequence(K.Redo), QKeySequence("Ctrl+Y")])
-        self.act_symmetrize = self._action(
-            "S&ymmetrize", self.doc.symmetrize, "Ctrl+Shift+Y", "Infer again with relaxed tolerance"
-        )
-        self.act_randomize = self._action("&Randomize…", self.randomize_dialog, "Ctrl+R")
-        self.act_unrandomize = self._action("Clear Randomization", lambda: self.doc.set_randomize(None))
-        self.act_replace = self._action("Re&place Symbol…", self.replace_dialog, "Ctrl+Shift+R")
-        self.act_grow = self._action(
-            "&Grow", lambda: self.change_count(+1), "Ctrl+]", "Increase the axiom's m"
-        )
-        self.act_shrink = self._action(
-            "S&hrink", lambda: self.change_count(-1), "Ctrl+[", "Decrease the axiom's m"
-        )
-        self.act_fit = self._action("&Fit", self.canvas.fit, "Ctrl+0")
-        self.act_100 = self._action("&100 %", self.canvas.zoom_100, "Ctrl+1")
-        self.act_zoom_in = self._action("Zoom &In", lambda: self.canvas.zoom_by(1.25), K.ZoomIn)
-        self.act_zoom_out = self._action("Zoom &Out", lambda: self.canvas.zoom_by(0.8), K.ZoomOut)
-        self.act_overlay = self._action("Show &Input Overlay", self.canvas.set_overlay_visible, "Ctrl+I")
-        self.act_overlay.setCheckable(True)
-        self.color_group = QActionGroup(self)
-        self.act_colors = {}
-        for mode, text in (
-            ("none", "Original Colours"),
-            ("group", "Colour by Similarity Group"),
-            ("rule", "Colour by Rule"),
-        ):
-            act = QAction(text, self, checkable=True)
-            act.setData(mode)
-            act.triggered.connect(lambda _checked=False, m=mode: self.canvas.set_color_mode(m))
-            self.color_group.addAction(act)
-            self.act_colors[mode] = act
-        self.act_colors["none"].setChecked(True)
-
-    def _create_menus(self) -> None:
-        bar = self.menuBar()
-        file_menu = bar.addMenu("&File")
-        file_menu.addAction(self.act_open)
-        self.recent_menu = file_menu.addMenu("Open &Recent")
-        self.recent.attach(self.recent_menu)
-        self.examples_menu = file_menu.addMenu("Open E&xample")
-        for path in examples():
-            act = self.examples_menu.addAction(path.stem.replace("-", " ").capitalize())
-            act.setToolTip(str(path))
-            act.triggered.connect(lambda _=False, p=str(path): self.open_path(p))
-        self.examples_menu.setEnabled(bool(self.examples_menu.actions()))
-        file_menu.addSeparator()
-        for act in (self.act_save, self.act_save_as):
-            file_menu.addAction(act)
-        file_menu.addSeparator()
-        for act in (self.act_export_svg, self.act_export_png):
-            file_menu.addAction(act)
-        file_menu.addSeparator()
-        file_menu.addAction(self.act_quit)
-        edit = bar.addMenu("&Edit")
-        for act in (self.act_undo, self.act_redo):
-            edit.addAction(act)
-        edit.addSeparator()
-        for act in (
-            self.act_symmetrize,
-            self.act_randomize,
-            self.act_unrandomize,
-            self.act_replace,
-            self.act_grow,
-            self.act_shrink,
-        ):
-            edit.addAction(act)
-        view = bar.addMenu("&View")
-        for act in (self.act_fit, self.act_100, self.act_zoom_in, self.act_zoom_out):
-            view.addAction(act)
-        view.addSeparator()
-        view.addAction(self.act_overlay)
-        for act in self.act_colors.values():
-            view.addAction(act)
-        view.addSeparator()
-        for dock in (self.rules_dock, self.params_dock, self.inference_dock):
-            view.addAction(dock.toggleViewAction())
-        tools = self.addToolBar("Main")
-        tools.setObjectName("toolbar-main")
-        for act in (
-            self.act_open,
-            self.act_save,
-            self.act_undo,
-            self.act_redo,
-            self.act_symmetrize,
-            self.act_randomize,
-            self.act_replace,
-            self.act_shrink,
-            self.act_grow,
-            self.act_fit,
-        ):
-            tools.addAction(act)
-
     def _connect(self) -> None:
         d = self.doc
         d.textChanged.connect(self.rules_panel.set_text)
@@ -265,6 +153,7 @@ class MainWindow(QMainWindow):
         self.canvas.elementClicked.connect(self._on_element_clicked)
         self.canvas.message.connect(self.show_message)
         self.rules_panel.textEdited.connect(d.edit_text)
+        self.rules_panel.editor.set_history_keys(undo_keys(), redo_keys())
         self.rules_panel.editor.undoRequested.connect(d.undo_stack.undo)
         self.rules_panel.editor.redoRequested.connect(d.undo_stack.redo)
         self.params_panel.paramEdited.connect(d.set_param)
@@ -276,6 +165,11 @@ class MainWindow(QMainWindow):
         self.inference_panel.cancelRequested.connect(d.cancel_inference)
         self.inference_panel.reinferRequested.connect(d.reinfer)
         self.canvas.set_interactive_source(lambda: d.interactive)
+
+    def set_color_mode(self, mode: str) -> None:
+        """Colour the canvas by ``"group"``, ``"rule"`` or not at all (``"none"``)."""
+        self.canvas.set_color_mode(mode)
+        self.act_colors[mode].setChecked(True)
 
     # -- messages and state -------------------------------------------------------------------------
     def show_message(self, text: str) -> None:

@@ -116,6 +116,8 @@ class RulesEditor(QPlainTextEdit):
         self._gutter = _LineNumbers(self)
         self._error: tuple[int, int, str] | None = None
         self._rule_lines: list[int] = []
+        self._undo_keys: list[QKeySequence] = []
+        self._redo_keys: list[QKeySequence] = []
         self.blockCountChanged.connect(self._update_gutter_width)
         self.updateRequest.connect(self._update_gutter)
         self._update_gutter_width()
@@ -234,20 +236,32 @@ class RulesEditor(QPlainTextEdit):
         self.verticalScrollBar().setValue(scroll)
         self._refresh_selections()
 
+    def set_history_keys(self, undo: list[QKeySequence], redo: list[QKeySequence]) -> None:
+        """Use these keys for undo and redo (the window's; default: the platform's standard keys)."""
+        self._undo_keys, self._redo_keys = list(undo), list(redo)
+
+    def _history_key(self, event) -> str | None:
+        """Return ``"undo"``/``"redo"`` if ``event`` is one of their keys, else None."""
+        pressed = QKeySequence(event.keyCombination())
+        if pressed in self._undo_keys or event.matches(QKeySequence.StandardKey.Undo):
+            return "undo"
+        if pressed in self._redo_keys or event.matches(QKeySequence.StandardKey.Redo):
+            return "redo"
+        return None
+
     def event(self, event) -> bool:
         """Leave undo/redo shortcuts to the window (the document's undo stack)."""
-        if event.type() == event.Type.ShortcutOverride and (
-            event.matches(QKeySequence.StandardKey.Undo) or event.matches(QKeySequence.StandardKey.Redo)
-        ):
+        if event.type() == event.Type.ShortcutOverride and self._history_key(event) is not None:
             event.accept()
             return True
         return super().event(event)
 
     def keyPressEvent(self, event) -> None:
         """Route undo/redo keys to the document; everything else edits the text."""
-        if event.matches(QKeySequence.StandardKey.Undo):
+        key = self._history_key(event)
+        if key == "undo":
             self.undoRequested.emit()
-        elif event.matches(QKeySequence.StandardKey.Redo):
+        elif key == "redo":
             self.redoRequested.emit()
         else:
             super().keyPressEvent(event)
