@@ -10,10 +10,7 @@ imports Qt (the inference worker process uses this module too).
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 from typing import Any
-
-from lsys_core.errors import LsysError
 
 __all__ = [
     "axiom_count",
@@ -186,13 +183,14 @@ def write_atomic(path: str, data: bytes) -> None:
 
 
 def read_text(path: str) -> str:
-    """Read a UTF-8 text file, reporting failures as one-line ``LsysError`` s."""
-    try:
-        return Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise LsysError(f"cannot read {path}: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise LsysError(f"cannot read {path}: not UTF-8 text") from None
+    """Read a UTF-8 text file as ``lsys`` does (``lsys_core.io.read_text``), with Unix line ends.
+
+    The size is bounded and the text checked as it is read; failures are one-line ``LsysError`` s
+    (too large, binary data, bad UTF-8 with its line and column).
+    """
+    from lsys_core.io import read_text as _read
+
+    return _read(path).replace("\r\n", "\n").replace("\r", "\n")
 
 
 # -- display helpers (picking, fitting) ---------------------------------------------------------------
