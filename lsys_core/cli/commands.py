@@ -154,7 +154,7 @@ def _parse_randomize(text: str | None, seed: int):
         if not (0.0 <= v < float("inf")):
             raise LsysError(f"--randomize: {key} must be a finite number >= 0, got {val!r}")
         amounts[key] = v
-    return Randomize(seed=seed, **amounts)
+    return Randomize(amounts["angle"], amounts["distance"], amounts["scale"], seed)
 
 
 def _parse_sets(items: list[str]) -> dict[str, float]:
