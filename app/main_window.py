@@ -105,6 +105,10 @@ class MainWindow(QMainWindow):
         for label in self._status_labels.values():
             self.statusBar().addPermanentWidget(label)
 
+        self._panels_timer = QTimer(self)
+        self._panels_timer.setSingleShot(True)
+        self._panels_timer.setInterval(0)
+        self._panels_timer.timeout.connect(self._update_panels)
         create_actions(self)
         create_menus(self, (self.rules_dock, self.params_dock, self.inference_dock))
         self._connect()
@@ -182,12 +186,19 @@ class MainWindow(QMainWindow):
         self._update_actions()
 
     def _on_grammar_changed(self, grammar: Any) -> None:
+        self._panels_timer.start()  # the panels follow in their own event-loop turn
+        self._update_status()
+        self._update_actions()
+
+    def _update_panels(self) -> None:
+        """Show the parameters of the current grammar (coalesced: the newest grammar only)."""
+        grammar = self.doc.grammar
+        if grammar is None:
+            return
         try:
             self.params_panel.set_params(core.list_params(grammar))
         except LsysError as exc:
             self.show_message(str(exc))
-        self._update_status()
-        self._update_actions()
 
     def _on_scene_changed(self) -> None:
         self.canvas.set_overlay_svg(self.doc.scene_path)
@@ -260,7 +271,12 @@ class MainWindow(QMainWindow):
     # -- idle (used by --screenshot and tests) -----------------------------------------------------------
     def is_idle(self) -> bool:
         """Whether nothing is pending: no inference, parse or derivation, and the canvas is final."""
-        return not self.doc.busy and self.canvas.is_idle()
+        return (
+            not self.doc.busy
+            and self.canvas.is_idle()
+            and not self._panels_timer.isActive()
+            and not self.rules_panel.editor.highlighter.pending
+        )
 
     # -- files ----------------------------------------------------------------------------------------
     def open_path(self, path: str) -> None:

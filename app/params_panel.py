@@ -12,21 +12,25 @@ from typing import Any
 
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (
-    QAbstractSpinBox,
     QDoubleSpinBox,
-    QFormLayout,
     QHBoxLayout,
     QLabel,
+    QPushButton,
     QScrollArea,
     QSlider,
-    QSpinBox,
+    QToolButton,
     QVBoxLayout,
     QWidget,
 )
 
-__all__ = ["ParamRow", "ParamsPanel", "slider_range"]
+__all__ = ["OPEN_ROWS", "ROWS_PER_PAGE", "ParamRow", "ParamsPanel", "slider_range"]
 
 SLIDER_STEPS = 1000
+#: Rows a section shows at once (more on request).
+ROWS_PER_PAGE = 24
+#: Sections open on a new grammar until about this many rows are shown.
+OPEN_ROWS = 40
+COUNT_MAX = 2**31 - 1
 _SPIN_LIMIT = 1e9
 
 
@@ -60,6 +64,9 @@ def slider_range(kind: str, value: float) -> tuple[float, float]:
 class ParamRow(QWidget):
     """One parameter: a slider over :func:`slider_range` and an exact spin box.
 
+    A row can show another parameter later (:meth:`configure`), so a new grammar reuses the rows
+    of the previous one instead of building new widgets.
+
     Signals
     -------
     valueEdited(key, value), dragStarted(), dragFinished()
@@ -71,32 +78,41 @@ class ParamRow(QWidget):
 
     def __init__(self, param: Any, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.key = param.key
-        self.kind = param.kind
-        self.integer = param.kind == "count"
-        self.lo, self.hi = slider_range(param.kind, param.value)
         self.slider = QSlider(Qt.Orientation.Horizontal, self)
         self.slider.setRange(0, SLIDER_STEPS)
         self.slider.setMinimumWidth(120)
-        if self.integer:
-            self.spin: QAbstractSpinBox = QSpinBox(self)
-            self.spin.setRange(0, 2**31 - 1)
-        else:
-            self.spin = QDoubleSpinBox(self)
-            self.spin.setRange(-_SPIN_LIMIT, _SPIN_LIMIT)
-            self.spin.setDecimals(4 if "scale" in param.kind or "delta" in param.kind else 3)
-            self.spin.setSingleStep((self.hi - self.lo) / 100)
+        self.spin = QDoubleSpinBox(self)
+        self.spin.setRange(-_SPIN_LIMIT, _SPIN_LIMIT)
         self.spin.setKeyboardTracking(False)
         self.spin.setMinimumWidth(90)
         layout = QHBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(self.slider, 1)
         layout.addWidget(self.spin)
-        self.set_value(param.value)
+        self.configure(param)
         self.slider.valueChanged.connect(self._on_slider)
         self.slider.sliderPressed.connect(self.dragStarted)
         self.slider.sliderReleased.connect(self.dragFinished)
         self.spin.valueChanged.connect(self._on_spin)
+
+    def configure(self, param: Any) -> None:
+        """Show ``param`` (``Param(key, label, value, kind)``), the range fixed for its value."""
+        self.key = param.key
+        self.kind = param.kind
+        self.integer = param.kind == "count"
+        self.lo, self.hi = slider_range(param.kind, param.value)
+        self.spin.blockSignals(True)
+        if self.integer:
+            self.spin.setDecimals(0)
+            self.spin.setRange(0, COUNT_MAX)
+            self.spin.setSingleStep(1)
+        else:
+            self.spin.setDecimals(4 if "scale" in param.kind or "delta" in param.kind else 3)
+            self.spin.setRange(-_SPIN_LIMIT, _SPIN_LIMIT)
+            self.spin.setSingleStep((self.hi - self.lo) / 100)
+        self.spin.blockSignals(False)
+        self._shown: float | None = None
+        self.set_value(param.value)
 
     def value(self) -> float:
         """Return the spin box value."""
@@ -108,6 +124,9 @@ class ParamRow(QWidget):
         A value outside the slider's range (typed, or set by undo) widens the range, unless the
         slider is being dragged.
         """
+        if value == self._shown:
+            return
+        self._shown = value
         if not self.lo <= value <= self.hi and not self.slider.isSliderDown():
             self.lo, self.hi = slider_range(self.kind, value)
         self.slider.blockSignals(True)
@@ -129,20 +148,124 @@ class ParamRow(QWidget):
 
     def _on_slider(self, pos: int) -> None:
         value = self._from_slider(pos)
+        self._shown = value
         self.spin.blockSignals(True)
-        self.spin.setValue(int(value) if self.integer else value)
+        self.spin.setValue(value)
         self.spin.blockSignals(False)
         self.valueEdited.emit(self.key, value)
 
     def _on_spin(self, value: float) -> None:
+        self._shown = float(value)
         self.slider.blockSignals(True)
         self.slider.setValue(self._to_slider(value))
         self.slider.blockSignals(False)
         self.valueEdited.emit(self.key, float(value))
 
 
+class _Line(QWidget):
+    """A label and a :class:`ParamRow`."""
+
+    def __init__(self, param: Any, parent: QWidget) -> None:
+        super().__init__(parent)
+        self.label = QLabel(self)
+        self.label.setMinimumWidth(70)
+        self.row = ParamRow(param, self)
+        layout = QHBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(self.label)
+        layout.addWidget(self.row, 1)
+        self.set_label(param)
+
+    def set_label(self, param: Any) -> None:
+        """Show the label of ``param`` (its rule name is the section's title, so it is left out)."""
+        text = param.label.split(": ", 1)[-1]
+        self.label.setText(text)
+        self.label.setToolTip(f"{param.label} — {param.key} ({param.kind.replace('_', ' ')})")
+
+
+class _Section(QWidget):
+    """The parameters of one rule (or the axiom) under a header that folds them away.
+
+    Rows exist only while the section is open, at most :data:`ROWS_PER_PAGE` more at a time
+    (*Show more*), and are reused when the section shows another rule.
+    """
+
+    def __init__(self, panel: ParamsPanel) -> None:
+        super().__init__(panel._content)
+        self.panel = panel
+        self.params: list[Any] = []
+        self.limit = ROWS_PER_PAGE
+        self.header = QToolButton(self)
+        self.header.setCheckable(True)
+        self.header.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextBesideIcon)
+        self.header.setAutoRaise(True)
+        self.header.toggled.connect(self._on_toggled)
+        self.body = QWidget(self)
+        self.rows_layout = QVBoxLayout(self.body)
+        self.rows_layout.setContentsMargins(14, 0, 0, 0)
+        self.rows_layout.setSpacing(2)
+        self.more = QPushButton(self.body)
+        self.more.setFlat(True)
+        self.more.clicked.connect(self._show_more)
+        self.rows_layout.addWidget(self.more)
+        self.lines: list[_Line] = []
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.setSpacing(0)
+        layout.addWidget(self.header)
+        layout.addWidget(self.body)
+
+    def configure(self, owner: str, params: list[Any], open_: bool) -> None:
+        """Show the parameters ``params`` of ``owner``; ``open_`` unfolds the section."""
+        self.params = params
+        self.limit = ROWS_PER_PAGE
+        n = len(params)
+        self.header.setText(f"{owner}  ({n} number{'s' if n != 1 else ''})")
+        self.header.blockSignals(True)
+        self.header.setChecked(open_)
+        self.header.blockSignals(False)
+        self._refresh()
+
+    def _on_toggled(self, _checked: bool) -> None:
+        self._refresh()
+
+    def _show_more(self) -> None:
+        self.limit += ROWS_PER_PAGE
+        self._refresh()
+
+    def _refresh(self) -> None:
+        open_ = self.header.isChecked()
+        self.header.setArrowType(Qt.ArrowType.DownArrow if open_ else Qt.ArrowType.RightArrow)
+        shown = self.params[: self.limit] if open_ else []
+        for i, p in enumerate(shown):
+            if i < len(self.lines):
+                line = self.lines[i]
+                line.row.configure(self.panel.current(p))
+                line.set_label(p)
+            else:
+                line = _Line(self.panel.current(p), self.body)
+                self.panel.connect_row(line.row)
+                self.rows_layout.insertWidget(len(self.lines), line)
+                self.lines.append(line)
+            line.show()
+            self.panel.rows[p.key] = line.row
+        for line in self.lines[len(shown) :]:
+            line.hide()
+            if self.panel.rows.get(line.row.key) is line.row:
+                del self.panel.rows[line.row.key]
+        rest = len(self.params) - len(shown)
+        self.more.setVisible(open_ and rest > 0)
+        self.more.setText(f"Show {min(rest, ROWS_PER_PAGE)} more of {rest}…")
+        self.body.setVisible(open_)
+
+
 class ParamsPanel(QWidget):
-    """The dock content: one :class:`ParamRow` per parameter, in a scroll area.
+    """The dock content: the numbers of the rules, one folding section per rule.
+
+    Only open sections have widgets, and they open a page of :data:`ROWS_PER_PAGE` rows at a
+    time; sections and rows are reused from one grammar to the next.  So a grammar with hundreds
+    of parameters costs a few dozen widgets, and applying new rules never blocks the window.
+    Sections open at first until :data:`OPEN_ROWS` rows are shown.
 
     Signals
     -------
@@ -156,9 +279,17 @@ class ParamsPanel(QWidget):
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.rows: dict[str, ParamRow] = {}
+        self._values: dict[str, Any] = {}
+        self._sections: list[_Section] = []
         self._kinds: list[tuple[str, str]] = []
         self._scroll = QScrollArea(self)
         self._scroll.setWidgetResizable(True)
+        self._content = QWidget()
+        self._column = QVBoxLayout(self._content)
+        self._column.setContentsMargins(4, 4, 4, 4)
+        self._column.setSpacing(0)
+        self._column.addStretch(1)
+        self._scroll.setWidget(self._content)
         self._empty = QLabel("Open an SVG or .lsys file to edit its parameters.", self)
         self._empty.setWordWrap(True)
         self._empty.setAlignment(Qt.AlignmentFlag.AlignCenter)
@@ -168,35 +299,52 @@ class ParamsPanel(QWidget):
         layout.addWidget(self._scroll, 1)
         self._scroll.hide()
 
+    def current(self, param: Any) -> Any:
+        """Return ``param`` with the newest value known for its key."""
+        return self._values.get(param.key, param)
+
+    def connect_row(self, row: ParamRow) -> None:
+        """Forward a new row's signals."""
+        row.valueEdited.connect(self.paramEdited)
+        row.dragStarted.connect(self.dragStarted)
+        row.dragFinished.connect(self.dragFinished)
+
     def set_params(self, params: list) -> None:
-        """Show ``params`` (``Param(key, label, value, kind)``): update values, or rebuild rows
-        when the set of parameters changed."""
+        """Show ``params`` (``Param(key, label, value, kind)``): update the values of the rows
+        shown, or re-configure the sections when the set of parameters changed."""
+        self._values = {p.key: p for p in params}
         kinds = [(p.key, p.kind) for p in params]
         if kinds == self._kinds:
-            for p in params:
-                row = self.rows[p.key]
+            for key, row in self.rows.items():
+                value = self._values[key].value
                 if not row.slider.isSliderDown() and not row.spin.hasFocus():
-                    row.set_value(p.value)
+                    row.set_value(value)
                 elif row.slider.isSliderDown():
                     row.spin.blockSignals(True)
-                    row.spin.setValue(round(p.value) if row.integer else p.value)
+                    row.spin.setValue(round(value) if row.integer else value)
                     row.spin.blockSignals(False)
             return
         self._kinds = kinds
-        self.rows = {}
-        content = QWidget()
-        form = QFormLayout(content)
-        form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
+        groups: dict[str, list[Any]] = {}
         for p in params:
-            row = ParamRow(p, content)
-            row.valueEdited.connect(self.paramEdited)
-            row.dragStarted.connect(self.dragStarted)
-            row.dragFinished.connect(self.dragFinished)
-            label = QLabel(p.label, content)
-            label.setToolTip(f"{p.key} ({p.kind.replace('_', ' ')})")
-            form.addRow(label, row)
-            self.rows[p.key] = row
-        self._scroll.setWidget(content)
+            groups.setdefault(p.key.split(".", 1)[0], []).append(p)
+        self.rows = {}
+        budget = OPEN_ROWS
+        for i, (owner, group) in enumerate(groups.items()):
+            if i < len(self._sections):
+                section = self._sections[i]
+            else:
+                section = _Section(self)
+                self._column.insertWidget(len(self._sections), section)
+                self._sections.append(section)
+            open_ = budget > 0
+            section.configure(owner, group, open_)
+            section.show()
+            if open_:
+                budget -= min(len(group), ROWS_PER_PAGE)
+        for section in self._sections[len(groups) :]:
+            section.configure("", [], False)
+            section.hide()
         self._scroll.setVisible(bool(params))
         self._empty.setVisible(not params)
         if not params:

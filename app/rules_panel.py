@@ -10,9 +10,10 @@ the text widget's own history.
 from __future__ import annotations
 
 import re
+import time
 from typing import Any
 
-from PySide6.QtCore import QRect, QRegularExpression, QSize, Qt, Signal
+from PySide6.QtCore import QRect, QRegularExpression, QSize, Qt, QTimer, Signal
 from PySide6.QtGui import (
     QColor,
     QFont,
@@ -29,7 +30,9 @@ from PySide6.QtWidgets import QLabel, QPlainTextEdit, QTextEdit, QVBoxLayout, QW
 
 __all__ = ["LsysHighlighter", "RulesEditor", "RulesPanel"]
 
-KEYWORDS = ("lsys", "canvas", "viewbox", "size", "terminal", "style", "mirror", "axiom")
+#: Longest time the highlighter colours lines in one event-loop turn after a new text.
+HIGHLIGHT_BUDGET_MS = 8.0
+KEYWORDS = ("lsys", "canvas", "viewbox", "size", "terminal", "style", "mirror", "axiom", "randomize")
 
 
 def _fmt(color: str, *, bold: bool = False, italic: bool = False) -> QTextCharFormat:
@@ -61,19 +64,68 @@ class LsysHighlighter(QSyntaxHighlighter):
         self._rules = [(QRegularExpression(p), f) for p, f in self.RULES]
         self._string = QRegularExpression(self.STRING[0])
         self._comment = QRegularExpression(self.COMMENT[0])
+        self._deferred = False
+        self._start_block = self._next_block = 0
+        self._timer = QTimer(self)
+        self._timer.setSingleShot(True)
+        self._timer.setInterval(0)
+        self._timer.timeout.connect(self._highlight_some)
+
+    @property
+    def pending(self) -> bool:
+        """Whether lines are still waiting to be coloured."""
+        return self._deferred or self._timer.isActive()
+
+    def defer(self) -> None:
+        """Colour nothing until :meth:`resume` (while a whole new text is set)."""
+        self._timer.stop()
+        self._deferred = True
+
+    def resume(self, first: int = 0) -> None:
+        """Colour the lines a few at a time from line ``first`` (the first visible), then the rest."""
+        self._deferred = False
+        self._start_block = max(0, first)
+        self._next_block = 0  # lines done, counted from the start line round to the one before
+        self._timer.start()  # in the next event-loop turns, not in the one that set the text
+
+    def _highlight_some(self) -> None:
+        doc = self.document()
+        if doc is None:
+            return
+        t0 = time.perf_counter()
+        count = doc.blockCount()
+        while self._next_block < count:
+            if (time.perf_counter() - t0) * 1e3 >= HIGHLIGHT_BUDGET_MS:
+                self._timer.start()
+                return
+            block = doc.findBlockByNumber((self._start_block + self._next_block) % count)
+            self._next_block += 1
+            if block.isValid():
+                self.rehighlightBlock(block)
 
     def highlightBlock(self, text: str) -> None:
         """Apply the formats to one line (strings and comments win over the rest)."""
+        if self._deferred:
+            return
+        strings = []
+        it = self._string.globalMatch(text)
+        while it.hasNext():
+            m = it.next()
+            strings.append((m.capturedStart(), m.capturedLength()))
+        plain = text
+        for start, length in strings:  # path data holds hundreds of numbers: do not colour them
+            plain = plain[:start] + " " * length + plain[start + length :]
         for rx, fmt in self._rules:
-            it = rx.globalMatch(text)
+            it = rx.globalMatch(plain)
             while it.hasNext():
                 m = it.next()
                 self.setFormat(m.capturedStart(), m.capturedLength(), fmt)
-        for rx, fmt in ((self._string, self.STRING[1]), (self._comment, self.COMMENT[1])):
-            it = rx.globalMatch(text)
-            while it.hasNext():
-                m = it.next()
-                self.setFormat(m.capturedStart(), m.capturedLength(), fmt)
+        for start, length in strings:
+            self.setFormat(start, length, self.STRING[1])
+        it = self._comment.globalMatch(plain)
+        while it.hasNext():
+            m = it.next()
+            self.setFormat(m.capturedStart(), len(text) - m.capturedStart(), self.COMMENT[1])
 
 
 class _LineNumbers(QWidget):
@@ -229,11 +281,13 @@ class RulesEditor(QPlainTextEdit):
             return
         pos = self.textCursor().position()
         scroll = self.verticalScrollBar().value()
+        self.highlighter.defer()
         self.setPlainText(text)
         cursor = self.textCursor()
         cursor.setPosition(min(pos, len(text)))
         self.setTextCursor(cursor)
         self.verticalScrollBar().setValue(scroll)
+        self.highlighter.resume(self.firstVisibleBlock().blockNumber())
         self._refresh_selections()
 
     def set_history_keys(self, undo: list[QKeySequence], redo: list[QKeySequence]) -> None:

@@ -14,6 +14,12 @@ Reports, in milliseconds:
 * the longest UI-thread stall while inference of a 1,200-element scene runs in the background,
   with inference in a worker thread and in a worker process: a 2 ms QTimer on the UI thread
   records the gaps between its ticks (a stall is a gap minus the 2 ms period).
+* weight change → new rules shown, for 300 and 1,200 elements (target ≤ 300 ms at 1,200): from
+  typing a new weight into the inference panel to the new rules in the text, the panels and a
+  full-quality frame on the canvas (inference in the editor's worker process).
+* the longest UI stall while new rules with 600 parameters are applied (target ≤ 50 ms), as the
+  gap of a 1 ms timer, with the UI thread's own CPU time in that gap (the rest is waiting for a
+  core: on a loaded machine the wall time overstates the stall).
 
 Scenes are derived from grammars and exported with ``lsys_core`` into a temporary folder.
 """
@@ -166,7 +172,7 @@ def bench_stall(app, workdir: Path, in_process: bool, seconds: float) -> dict:
         export_svg(derive(parse_grammar(grid_grammar(30, 40, step=20.0, bend=3.0, gap=25.0))), svg)
     win = make_window(**({} if in_process else {"infer_compute": run_inference}))
     if in_process:
-        win.doc._infer_compute.start()
+        win.doc.warm_up()
         time.sleep(1.5)  # let the process finish its imports, as it does while the window opens
     ticks: list[float] = []
     timer = QTimer()
@@ -200,12 +206,104 @@ def bench_stall(app, workdir: Path, in_process: bool, seconds: float) -> dict:
     }
 
 
+def scene_svg(workdir: Path, rows: int, cols: int) -> Path:
+    """Return an SVG of ``rows`` × ``cols`` leaves in gently curved rows (exported once)."""
+    from lsys_core.derive.derivation import derive
+    from lsys_core.grammar import parse_grammar
+    from lsys_core.render.svg import export_svg
+
+    svg = workdir / f"scene-{rows}x{cols}.svg"
+    if not svg.exists():
+        export_svg(derive(parse_grammar(grid_grammar(rows, cols, step=20.0, bend=3.0, gap=25.0))), svg)
+    return svg
+
+
+def bench_reweight(app, workdir: Path, rows: int, cols: int, repeats: int) -> dict:
+    """Time weight changes (typed into the inference panel) until the new rules are on screen."""
+    win = make_window()
+    win.doc.warm_up()
+    win.open_path(str(scene_svg(workdir, rows, cols)))
+    wait_until(app, win.is_idle, timeout=600)
+    spin = win.inference_panel.rows["wh"].spin
+    times, changed = [], 0
+    for k in range(repeats):
+        before = win.doc.text
+        t0 = time.perf_counter()
+        spin.setValue(0.5 if k % 2 == 0 else 1.0)
+        wait_until(app, lambda: win.doc.pending_settings is None and win.is_idle(), timeout=600)
+        win.canvas.repaint()
+        times.append((time.perf_counter() - t0) * 1e3)
+        changed += win.doc.text != before
+    n = len(win.doc.drawing)
+    win.doc.undo_stack.setClean()
+    win.close()
+    return {"elements": n, "median_ms": statistics.median(times), "max_ms": max(times), "changed": changed}
+
+
+def many_params_grammar(rules: int, shift: int) -> str:
+    """Return .lsys text with ``rules`` sequences of 5 numbers each (a big, flat grammar)."""
+    lines = ["lsys 1", 'terminal A "M 0 0 L 4 0 L 4 4 Z" style "fill:#789"']
+    lines.append("axiom: " + " ".join(f"[ f({i * 7 + shift}) +(90) P{i}(3) ]" for i in range(rules)))
+    for i in range(rules):
+        a = i % 7 + 1
+        lines.append(f"P{i}(m): m > 0 -> A +({a}) f(10) *(0.99) +(-{a}) P{i}(m-1)")
+        lines.append(f"P{i}(m): m == 0 -> A")
+    return "\n".join(lines) + "\n"
+
+
+class _TickRecorder(list):
+    """A list filled with (wall, UI-thread CPU) times by a 1 ms timer."""
+
+    def __init__(self) -> None:
+        from PySide6.QtCore import QTimer
+
+        super().__init__()
+        self.timer = QTimer()
+        self.timer.setInterval(1)
+        self.timer.timeout.connect(lambda: self.append((time.perf_counter(), time.thread_time())))
+        self.timer.start()
+
+
+def bench_apply_stall(app, workdir: Path, repeats: int) -> dict:
+    """Longest gap of a 1 ms UI timer while rules with ~600 parameters replace others."""
+    from app.jobs import run_inference
+    from lsys_core.grammar import list_params, parse_grammar
+
+    path = workdir / "many.lsys"
+    path.write_text(many_params_grammar(120, 0), encoding="utf-8")
+    win = make_window(infer_compute=run_inference)
+    win.open_path(str(path))
+    wait_until(app, win.is_idle)
+    worst = (0.0, 0.0)
+    params = 0
+    for k in range(repeats):
+        grammar = parse_grammar(many_params_grammar(120 - k % 2, k + 1))  # another set of parameters
+        params = len(list_params(grammar))
+        ticks = _TickRecorder()
+        wait_until(app, lambda t=ticks: len(t) > 10)
+        win.doc.apply_grammar(grammar, "bench")
+        wait_until(app, win.is_idle)
+        seen = len(ticks)
+        wait_until(app, lambda t=ticks, n=seen: len(t) > n + 10)
+        ticks.timer.stop()
+        for (w0, c0), (w1, c1) in itertools.pairwise(ticks):
+            if (w1 - w0) * 1e3 > worst[0]:
+                worst = ((w1 - w0) * 1e3, (c1 - c0) * 1e3)
+    win.doc.undo_stack.setClean()
+    win.close()
+    return {"params": params, "max_stall_ms": worst[0], "ui_cpu_in_it_ms": worst[1]}
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--json", help="also write the figures to this file")
     parser.add_argument("--quick", action="store_true", help="fewer moves and a shorter inference window")
     parser.add_argument("--stall-seconds", type=float, default=20.0, help="longest inference observed")
+    parser.add_argument(
+        "--only", default="slider,stall,reweight,apply", help="comma-separated parts to run (default: all)"
+    )
     args = parser.parse_args(argv)
+    parts = set(args.only.split(","))
     from PySide6.QtWidgets import QApplication
 
     app = QApplication.instance() or QApplication([])
@@ -214,7 +312,7 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         targets = {10_000: (16, 100), 100_000: (250, None)}
-        for rows, cols in ((100, 100), (250, 400)):
+        for rows, cols in ((100, 100), (250, 400)) if "slider" in parts else ():
             r = bench_slider(app, work, rows, cols, moves)
             out["slider"].append(r)
             drag_target, full_target = targets[r["elements"]]
@@ -226,13 +324,28 @@ def main(argv=None) -> int:
                 flush=True,
             )
         seconds = 8.0 if args.quick else args.stall_seconds
-        for in_process in (False, True):
+        for in_process in (False, True) if "stall" in parts else ():
             r = bench_stall(app, work, in_process, seconds)
             out["stall"].append(r)
             print(
                 f"inference of 1,200 elements in a {r['mode']:7s}: longest UI stall {r['max_stall_ms']:.1f} ms, "
                 f"p99 {r['p99_stall_ms']:.1f} ms over {r['observed_s']} s "
                 f"({'finished' if r['inference_finished'] else 'still running'}; cancel took {r['cancel_s']} s)",
+                flush=True,
+            )
+        for rows, cols in ((15, 20), (30, 40)) if "reweight" in parts else ():
+            r = bench_reweight(app, work, rows, cols, 3 if args.quick else 6)
+            out.setdefault("reweight", []).append(r)
+            print(
+                f"weight change → rules shown, {r['elements']:,} elements: {r['median_ms']:.0f} ms median, "
+                f"{r['max_ms']:.0f} ms max (target ≤ 300 ms at 1,200; rules changed {r['changed']} times)",
+                flush=True,
+            )
+        for r in [bench_apply_stall(app, work, 2 if args.quick else 4)] if "apply" in parts else []:
+            out["apply_stall"] = r
+            print(
+                f"applying rules with {r['params']} parameters: longest UI stall {r['max_stall_ms']:.1f} ms "
+                f"(UI-thread CPU in it {r['ui_cpu_in_it_ms']:.1f} ms; target ≤ 50)",
                 flush=True,
             )
     if args.json:
