@@ -16,6 +16,7 @@ from lsys_core.cancel import CancelToken, Progress, check, report
 from lsys_core.derive.derivation import derive
 from lsys_core.errors import InferenceError
 from lsys_core.grammar.model import Grammar
+from lsys_core.hierarchy.mdl import Precision, grammar_bits
 from lsys_core.hierarchy.pivots import estimate_pivots, recenter
 from lsys_core.hierarchy.postprocess import simplify
 from lsys_core.hierarchy.rules import Hierarchy, Tolerance, Weights, build_hierarchy
@@ -30,19 +31,18 @@ __all__ = ["InferenceResult", "InferenceSettings", "infer", "symmetrize"]
 
 #: Bandwidth factor used by :func:`symmetrize` (the paper's "relaxed sensitivity").
 RELAXED = 12.0
-#: Largest reproduction error (relative to the scene's diagonal) :func:`infer` accepts
-#: when it relaxes the clustering to explain jittered repetitions.
-INFER_ERROR = 0.004
+#: Default tolerance: the derived drawing may deviate from the input by this share of its diagonal.
+DEFAULT_DEVIATION = 0.005
+#: With tolerance 0 (exact copies only), rules still place elements to this share of the
+#: diagonal: the precision SVG coordinates are written at.
+EXACT_PLACEMENT = 1e-4
 #: Largest deviation (relative to the scene's diagonal) of an element from the terminal
 #: drawn in its place; elements farther from their group's shape get a terminal of their own.
 SHAPE_ERROR = 0.002
 #: Scenes with more elements than this try fewer relaxed tolerances (see :func:`_factors`).
 LARGE_SCENE = 1000
-#: A relaxed grammar may deviate up to this much if it needs at most :data:`JITTER_GAIN`
-#: times the productions of the exact one (jittered repetitions, paper Fig. 10).
-JITTER_ERROR = 0.025
-JITTER_GAIN = 0.7
-#: The same for :func:`symmetrize`, whose purpose is to move elements onto a regular pattern.
+#: The tolerance of :func:`symmetrize`, whose purpose is to move elements onto a regular pattern
+#: (share of the diagonal; the user's tolerance if larger).
 SYMMETRIZE_ERROR = 0.03
 
 
@@ -121,15 +121,6 @@ def _shape_similarity(inst: Instancing, cancel: CancelToken | None) -> np.ndarra
     return terminal_similarity(inst.terminals, cancel=cancel)
 
 
-def description_size(g: Grammar) -> int:
-    """Size of a grammar's rules: modules in all productions and the axiom, plus one per production.
-
-    Used to compare grammars found at different tolerances: a rule that merely lists the
-    nodes no repetition explains is as large as what it lists.
-    """
-    return len(g.axiom) + sum(1 + len(c.body) for r in g.rules for c in r.cases)
-
-
 def _diagonal(center: np.ndarray, radius: np.ndarray) -> float:
     lo = np.array([np.min(center.real - radius), np.min(center.imag - radius)])
     hi = np.array([np.max(center.real + radius), np.max(center.imag + radius)])
@@ -154,8 +145,10 @@ def _factors(settings: InferenceSettings, symmetrizing: bool, n: int) -> list[fl
 def reproduction_error(inst: Instancing, sizes: np.ndarray, drawing) -> float:
     """Largest displacement of an input element in ``drawing`` (document units).
 
-    Each input element is matched to the nearest derived instance of its terminal; the
-    displacement counts the translation and the rotation/scale change at the shape's radius.
+    Each input element is matched to the nearest derived instance of its terminal (by
+    position, and by rotation and scale at the shape's radius: copies turned about one point
+    share their position); the displacement counts the translation and the rotation/scale
+    change at the shape's radius.
     Missing instances count as infinitely far.
     """
     from scipy.spatial import cKDTree
@@ -168,11 +161,13 @@ def reproduction_error(inst: Instancing, sizes: np.ndarray, drawing) -> float:
             return float("inf")
         if mine.size == 0:
             continue
-        tb = drawing.b[theirs]
-        _, j = cKDTree(np.column_stack([tb.real, tb.imag])).query(
-            np.column_stack([inst.b[mine].real, inst.b[mine].imag])
-        )
-        err = np.abs(inst.b[mine] - tb[j]) + sizes[g] * np.abs(inst.a[mine] - drawing.a[theirs][j])
+
+        def poses(a: np.ndarray, b: np.ndarray, size: float = float(sizes[g])) -> np.ndarray:
+            return np.column_stack([b.real, b.imag, size * a.real, size * a.imag])
+
+        ta, tb = drawing.a[theirs], drawing.b[theirs]
+        _, j = cKDTree(poses(ta, tb)).query(poses(inst.a[mine], inst.b[mine]))
+        err = np.abs(inst.b[mine] - tb[j]) + sizes[g] * np.abs(inst.a[mine] - ta[j])
         worst = max(worst, float(err.max()))
     return worst
 
@@ -202,11 +197,11 @@ def infer(
 
     Notes
     -----
-    If the rules found at the user's tolerance leave elements unexplained by any
-    repetition, the clustering is relaxed (×3 … ×15) and the grammar with the fewest
-    rules (:func:`description_size`) is kept among those that deviate at most
-    :data:`INFER_ERROR` from the input, or at most :data:`JITTER_ERROR` when they are
-    clearly smaller (a jittered pattern).
+    Rules are written only when they shorten the description of the drawing (minimum
+    description length, :mod:`lsys_core.hierarchy.mdl`) and derive their elements within the
+    tolerance.  If the rules found at the user's clustering bandwidth leave elements
+    unexplained by any repetition, the clustering is relaxed (×3 … ×15) and the shortest
+    grammar (in bits) that stays within the tolerance is kept.
 
     Returns
     -------
@@ -237,14 +232,18 @@ def infer(
     sizes = np.zeros(len(inst.terminals))
     np.maximum.at(sizes, inst.group, radius / np.maximum(np.abs(inst.a), 1e-300))
     t = time.perf_counter()
+    diag = _diagonal(center, radius)
+    prec = Precision.of_circles(center, radius, max(DEFAULT_DEVIATION * diag, EXACT_PLACEMENT * diag))
     inst = unwrap_symmetric(inst)
-    inst = recenter(inst, estimate_pivots(inst, sizes))
+    offsets = estimate_pivots(inst, sizes, tolerance=prec.eps)
+    inst = recenter(inst, offsets)
+    sizes = sizes + np.abs(offsets)  # how far each shape reaches from its (moved) origin
     stages["pivots"] = time.perf_counter() - t
     weights = Weights(settings.wn, settings.wh, settings.wphi, settings.wl)
-    diag = _diagonal(center, radius)
+    if symmetrizing:
+        prec = prec.relaxed(max(prec.eps, SYMMETRIZE_ERROR * diag))
     shape_sim = _shape_similarity(inst, cancel)
-    best: tuple[Grammar, Hierarchy, float] | None = None
-    first_count: int | None = None  # production count of the first try, which is always kept
+    best: tuple[Grammar, Hierarchy, float, float] | None = None
     for factor in _factors(settings, symmetrizing, len(scene.elements)):
         check(cancel)
         hier = build_hierarchy(
@@ -258,6 +257,8 @@ def infer(
             weights=weights,
             tol=Tolerance().scaled(factor),
             similarity=shape_sim,
+            precision=prec,
+            symmetry=inst.symmetry,
             neighbours=settings.neighbours,
             cancel=cancel,
             progress=progress,
@@ -265,26 +266,19 @@ def infer(
         )
         t = time.perf_counter()
         grammar = simplify(Grammar(inst.terminals, tuple(hier.rules), hier.axiom, scene.viewbox, scene.size))
-        error = (
-            reproduction_error(inst, sizes, derive(grammar, limit=max(10 * len(scene.elements), 1000))) / diag
-        )
+        error = reproduction_error(inst, sizes, derive(grammar, limit=max(10 * len(scene.elements), 1000)))
+        bits = grammar_bits(grammar, prec)
         stages["postprocess"] = stages.get("postprocess", 0.0) + time.perf_counter() - t
-        count = description_size(grammar)
-        if first_count is None:
-            ok = True
-        elif symmetrizing:
-            ok = error <= SYMMETRIZE_ERROR
-        else:
-            ok = error <= INFER_ERROR or (error <= JITTER_ERROR and count <= JITTER_GAIN * first_count)
-        if ok and (best is None or (count, error) < (description_size(best[0]), best[2])):
-            best = (grammar, hier, error)
-        if first_count is None:
-            first_count = count
+        # The first try is always kept; relaxed ones must stay within the tolerance and be shorter.
+        if best is None or (error <= prec.eps and (bits, error) < (best[3], best[2])):
+            best = (grammar, hier, error, bits)
         if hier.closed and not symmetrizing:
             break  # every element is explained by repetitions: no need to relax
+        if hier.levels == 0 and len(scene.elements) > LARGE_SCENE:
+            break  # nothing repeats at all in a large scene: relaxing would only find chance
     assert best is not None  # _factors is never empty and the first try is always kept
-    grammar, hier, error = best
-    stages["reproduction_error"] = error
+    grammar, hier, error, _ = best
+    stages["reproduction_error"] = error / diag
     report(progress, "done", 1.0)
     return InferenceResult(grammar, inst, stages, time.perf_counter() - t_all, tuple(hier.log))
 

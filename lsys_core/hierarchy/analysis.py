@@ -28,13 +28,16 @@ from lsys_core.hierarchy.candidates import (
 )
 from lsys_core.hierarchy.chains import chain_pairs, chains
 from lsys_core.hierarchy.clustering import group_indices, mean_shift
+from lsys_core.hierarchy.gain import Ledger, cluster_bounds
 from lsys_core.hierarchy.linear import linear_candidates
 from lsys_core.hierarchy.spaces import PairSpace
 
 __all__ = ["find_candidates"]
 
 
-def find_candidates(ctx: Context, sym: np.ndarray, ps: PairSpace, radius: np.ndarray) -> list[Candidate]:
+def find_candidates(
+    ctx: Context, sym: np.ndarray, ps: PairSpace, radius: np.ndarray, ledger: Ledger | None = None
+) -> list[Candidate]:
     """Return the candidate rules of one level.
 
     Parameters
@@ -47,6 +50,9 @@ def find_candidates(ctx: Context, sym: np.ndarray, ps: PairSpace, radius: np.nda
         The pairs of this level and their relative transforms.
     radius : ndarray
         Radius of every live node's geometry.
+    ledger : Ledger, optional
+        The description length of the level: clusters that cannot shorten it, even at best
+        (:func:`~lsys_core.hierarchy.gain.cluster_bounds`), are not examined further.
     """
     if len(ps) == 0:
         return []
@@ -66,6 +72,9 @@ def find_candidates(ctx: Context, sym: np.ndarray, ps: PairSpace, radius: np.nda
         ]
     )
     labels, _ = mean_shift(emb)
+    if ledger is not None:
+        hopeless = cluster_bounds(ledger, labels, ps.src, ps.dst) <= 0.0
+        labels = np.where((labels >= 0) & ~hopeless[np.maximum(labels, 0)], labels, -1)
     prox = proximity(ps, sym.size, radius)
     n_nodes = sym.size
     out: list[Candidate] = []
@@ -107,7 +116,7 @@ def find_candidates(ctx: Context, sym: np.ndarray, ps: PairSpace, radius: np.nda
         out[k] = replace(out[k], l=_alternation_length(cl.succ, by_space.get(cl.space[::-1], [])))
     same = {k: v for k, v in by_space.items() if k[0] == k[1]}
     out += branch_candidates(ps, same, prox, n_nodes)
-    out += linear_candidates(ctx, sym, ps, prox, size, key)
+    out += linear_candidates(ctx, sym, ps, prox, size, key, ledger)
     return out
 
 

@@ -35,7 +35,20 @@ from lsys_core.hierarchy.candidates import (
 )
 from lsys_core.hierarchy.symbols import SymbolTable
 
-__all__ = ["ANGLE_SNAP", "DISTANCE_SNAP", "SCALE_SNAP", "Emitted", "const_t", "emit", "nice", "t_modules"]
+__all__ = [
+    "ANGLE_SNAP",
+    "DISTANCE_SNAP",
+    "SCALE_SNAP",
+    "Emitted",
+    "const_t",
+    "const_t_many",
+    "counters",
+    "emit",
+    "nice",
+    "nice_array",
+    "rule_cases",
+    "t_modules",
+]
 
 #: Written values are the shortest decimals within these tolerances of the measured ones
 #: (degrees; relative for distances and scales, which compound along a sequence).
@@ -99,30 +112,54 @@ def const_t(A: complex, B: complex) -> tuple[Module, ...]:
     return t_modules(Linear(al), Linear(d), Linear(s), Linear(be))
 
 
-def _recursive(table: SymbolTable, name: str, si: int, step: tuple[Module, ...]) -> Rule:
+def nice_array(x: np.ndarray, *, abs_tol: float = 0.0, rel_tol: float = 0.0) -> np.ndarray:
+    """:func:`nice` of every value of ``x`` (vectorised)."""
+    x = np.asarray(x, float)
+    tol = np.maximum(abs_tol, rel_tol * np.abs(x))
+    out = np.where(np.isfinite(x), np.round(x, 12), x)
+    done = (x == 0) | ~np.isfinite(x)
+    out = np.where(x == 0, 0.0, out)
+    for digits in range(0, 12):
+        y = np.round(x, digits)
+        hit = ~done & (np.abs(y - x) <= tol)
+        out = np.where(hit, y, out)
+        done |= hit
+    return out + 0.0
+
+
+def const_t_many(A: np.ndarray, B: np.ndarray) -> list[tuple[Module, ...]]:
+    """:func:`const_t` of many relative frames at once (the same modules, computed vectorised)."""
+    al, d, s, be = (np.asarray(v, float) for v in t4_from_rel(A, B))
+    flip = np.abs(wrap_deg(al)) > 90.0
+    al = np.where(flip, wrap_deg(al - 180.0), wrap_deg(al))
+    d = np.where(flip, -d, d)
+    be = wrap_deg(np.where(flip, be + 180.0, be))
+    cols = (
+        ("+", np.abs(al) > 1e-9, nice_array(al, abs_tol=ANGLE_SNAP)),
+        ("f", np.abs(d) > 1e-12, nice_array(d, rel_tol=DISTANCE_SNAP)),
+        ("*", np.abs(s - 1.0) > 1e-9, nice_array(s, rel_tol=SCALE_SNAP)),
+        ("+", np.abs(be) > 1e-9, nice_array(be, abs_tol=ANGLE_SNAP)),
+    )
+    out: list[tuple[Module, ...]] = []
+    for i in range(al.size):
+        out.append(tuple(Turtle(op, Linear(float(v[i]))) for op, on, v in cols if on[i]))  # type: ignore[arg-type]
+    return out
+
+
+def _recursive(table: SymbolTable, name: str, si: int, step: tuple[Module, ...]) -> tuple[Case, ...]:
     gt = Case(COND_GT0, (*table.draw(si), *step, Symbol(name, Count(-1, 1))))
     eq = Case(COND_EQ0, table.draw(si, last=True))
-    return Rule(name, True, (gt, eq))
+    return (gt, eq)
 
 
-def emit(table: SymbolTable, c: Candidate) -> Emitted:
-    """Write candidate ``c`` as a new rule and register the symbols of its applications."""
+def rule_cases(table: SymbolTable, c: Candidate, name: str) -> tuple[Case, ...]:
+    """The productions of candidate ``c`` as rule ``name`` (nothing is registered in ``table``)."""
     si, sj = c.space
-    name_of = table.infos
     if isinstance(c, PairCandidate):
-        name = table.new_name("X")
-        body = table.draw(si) + const_t(c.A, c.B) + table.draw(sj, last=True)
-        rule = Rule(name, False, (Case(None, body),))
-        syms = tuple(table.symbol(name, None) for _ in c.groups)
-        log = f"{name}: {len(c.groups)} pairs {name_of[si].name}-{name_of[sj].name}"
-        return Emitted(rule, log, c.groups, syms)
+        return (Case(None, table.draw(si) + const_t(c.A, c.B) + table.draw(sj, last=True)),)
     if isinstance(c, SeqCandidate):
-        name = table.new_name("P")
-        rule = _recursive(table, name, si, const_t(c.A, c.B))
-        lengths = sorted({int(g.size) for g in c.groups})
-        log = f"{name}: {len(c.groups)} sequences of {name_of[si].name}, lengths {lengths}"
-    elif isinstance(c, LinearCandidate):
-        name = table.new_name("P")
+        return _recursive(table, name, si, const_t(c.A, c.B))
+    if isinstance(c, LinearCandidate):
         k = c.steps
         step = t_modules(
             Linear(c.alpha0 + k * c.d_alpha, -c.d_alpha),
@@ -130,19 +167,45 @@ def emit(table: SymbolTable, c: Candidate) -> Emitted:
             Linear(c.s),
             Linear(c.beta0 + k * c.d_beta, -c.d_beta),
         )
-        rule = _recursive(table, name, si, step)
-        log = f"{name}: {len(c.groups)} sequences with linear angles ({c.d_alpha:.3g}°, {c.d_beta:.3g}°/step)"
-    elif isinstance(c, BranchCandidate):
-        name = table.new_name("R")
+        return _recursive(table, name, si, step)
+    if isinstance(c, BranchCandidate):
         (A1, B1), (A2, B2) = c.first, c.second
         rec = Symbol(name, Count(-1, 1))
         gt = Case(COND_GT0, (*table.draw(si), Push(), *const_t(A1, B1), rec, Pop(), *const_t(A2, B2), rec))
-        eq = Case(COND_EQ0, table.draw(si, last=True))
-        rule = Rule(name, True, (gt, eq))
-        syms = tuple(table.symbol(name, d) for d in c.depths)
-        log = f"{name}: {len(c.groups)} branching structures, depths {sorted(set(c.depths))}"
-        return Emitted(rule, log, c.groups, syms)
-    else:  # pragma: no cover - every kind is handled above
-        raise TypeError(f"unknown candidate {type(c).__name__}")
-    syms = tuple(table.symbol(name, int(g.size) - 1) for g in c.groups)
-    return Emitted(rule, log, c.groups, syms)
+        return (gt, Case(COND_EQ0, table.draw(si, last=True)))
+    raise TypeError(f"unknown candidate {type(c).__name__}")  # pragma: no cover
+
+
+def counters(c: Candidate) -> tuple[int | None, ...]:
+    """The counter every application of ``c`` calls its rule with (None: the rule takes none)."""
+    if isinstance(c, PairCandidate):
+        return tuple(None for _ in c.groups)
+    if isinstance(c, BranchCandidate):
+        return c.depths
+    return tuple(int(g.size) - 1 for g in c.groups)
+
+
+_PREFIX = {PairCandidate: "X", SeqCandidate: "P", LinearCandidate: "P", BranchCandidate: "R"}
+
+
+def _log(table: SymbolTable, c: Candidate, name: str) -> str:
+    si, sj = c.space
+    first, second = table.infos[si].name, table.infos[sj].name
+    if isinstance(c, PairCandidate):
+        return f"{name}: {len(c.groups)} pairs {first}-{second}"
+    if isinstance(c, LinearCandidate):
+        return (
+            f"{name}: {len(c.groups)} sequences with linear angles ({c.d_alpha:.3g}°, {c.d_beta:.3g}°/step)"
+        )
+    if isinstance(c, BranchCandidate):
+        return f"{name}: {len(c.groups)} branching structures, depths {sorted(set(c.depths))}"
+    return f"{name}: {len(c.groups)} sequences of {first}, lengths {sorted({int(g.size) for g in c.groups})}"
+
+
+def emit(table: SymbolTable, c: Candidate) -> Emitted:
+    """Write candidate ``c`` as a new rule and register the symbols of its applications."""
+    name = table.new_name(_PREFIX[type(c)])
+    cases = rule_cases(table, c, name)
+    rule = Rule(name, not isinstance(c, PairCandidate), cases)
+    syms = tuple(table.symbol(name, m) for m in counters(c))
+    return Emitted(rule, _log(table, c, name), c.groups, syms)

@@ -14,6 +14,7 @@ from lsys_core.geometry.transforms import wrap_deg
 from lsys_core.hierarchy.candidates import Context, LinearCandidate
 from lsys_core.hierarchy.chains import edge_chains, successor_pairs
 from lsys_core.hierarchy.clustering import group_indices, mean_shift
+from lsys_core.hierarchy.gain import Ledger, cluster_bounds
 from lsys_core.hierarchy.spaces import PairSpace
 
 __all__ = ["linear_candidates"]
@@ -23,9 +24,18 @@ _STEP_CLUSTERS = 12
 
 
 def linear_candidates(
-    ctx: Context, sym: np.ndarray, ps: PairSpace, prox: np.ndarray, size: np.ndarray, key: np.ndarray
+    ctx: Context,
+    sym: np.ndarray,
+    ps: PairSpace,
+    prox: np.ndarray,
+    size: np.ndarray,
+    key: np.ndarray,
+    ledger: Ledger | None = None,
 ) -> list[LinearCandidate]:
-    """Sequences whose α and β change by a constant step (clusters D in the (d, s) subspace)."""
+    """Sequences whose α and β change by a constant step (clusters D in the (d, s) subspace).
+
+    With a ``ledger``, clusters that cannot shorten the description are skipped.
+    """
     tol = ctx.tol
     ok = (ps.d / size > 0.1) & (sym[ps.src] == sym[ps.dst])
     if ok.sum() < 2:
@@ -33,30 +43,74 @@ def linear_candidates(
     sel = np.flatnonzero(ok)
     emb = np.column_stack([ps.d[sel] / (size[sel] * tol.xy), np.log(ps.s[sel]) / tol.scale, key[sel] * 1e7])
     labels, _ = mean_shift(emb)
-    out = []
+    if ledger is not None:
+        hopeless = cluster_bounds(ledger, labels, ps.src[sel], ps.dst[sel]) <= 0.0
+        labels = np.where((labels >= 0) & ~hopeless[np.maximum(labels, 0)], labels, -1)
+    keep = labels >= 0
+    if keep.sum() < 2:
+        return []
+    # Consecutive pairs i→j→k inside each (d, s) cluster, for all clusters at once.
+    n = sym.size
+    idx, lab = sel[keep], labels[keep].astype(np.int64)
+    e1, e2 = successor_pairs(lab * n + ps.src[idx], lab * n + ps.dst[idx], np.arange(idx.size))
+    if e1.size < 2:
+        return []
+    cluster = lab[e1]
+    e1, e2 = idx[e1], idx[e2]
     ang = np.deg2rad(tol.angle)
-    for g in group_indices(labels):
-        if g.size < 2:
+    da = np.deg2rad(wrap_deg(ps.alpha[e2] - ps.alpha[e1]))
+    db = np.deg2rad(wrap_deg(ps.beta[e2] - ps.beta[e1]))
+    emb2 = np.column_stack(
+        [np.cos(da) / ang, np.sin(da) / ang, np.cos(db) / ang, np.sin(db) / ang, cluster * 1e7]
+    )
+    lab2, _ = mean_shift(emb2)
+    if ledger is not None:
+        lab2 = _promising(ledger, lab2, e1, e2, ps)
+    out = []
+    taken: dict[int, int] = {}
+    for g2 in group_indices(lab2):
+        if g2.size < 2:
+            continue  # a single consecutive pair is no sequence
+        c = int(cluster[g2[0]])
+        taken[c] = taken.get(c, 0) + 1
+        if taken[c] > _STEP_CLUSTERS:
             continue
-        idx = sel[g]
-        e1a, e2a = successor_pairs(ps.src, ps.dst, idx)
-        if e1a.size < 1:
-            continue
-        da = np.deg2rad(wrap_deg(ps.alpha[e2a] - ps.alpha[e1a]))
-        db = np.deg2rad(wrap_deg(ps.beta[e2a] - ps.beta[e1a]))
-        emb2 = np.column_stack([np.cos(da), np.sin(da), np.cos(db), np.sin(db)]) / ang
-        lab2, _ = mean_shift(emb2)
-        for g2 in group_indices(lab2)[:_STEP_CLUSTERS]:
-            if g2.size < 2:
-                continue  # a single consecutive pair is no sequence
-            dA = float(np.rad2deg(np.arctan2(emb2[g2, 1].mean(), emb2[g2, 0].mean())))
-            dB = float(np.rad2deg(np.arctan2(emb2[g2, 3].mean(), emb2[g2, 2].mean())))
-            if abs(dA) < tol.angle and abs(dB) < tol.angle:
-                continue  # constant transform: a cluster C already covers it
-            cand = _linear_chains(ctx, sym, ps, e1a[g2], e2a[g2], dA, dB, prox)
-            if cand is not None:
-                out.append(cand)
+        dA = float(np.rad2deg(np.arctan2(emb2[g2, 1].mean(), emb2[g2, 0].mean())))
+        dB = float(np.rad2deg(np.arctan2(emb2[g2, 3].mean(), emb2[g2, 2].mean())))
+        if abs(dA) < tol.angle and abs(dB) < tol.angle:
+            continue  # constant transform: a cluster C already covers it
+        cand = _linear_chains(ctx, sym, ps, e1[g2], e2[g2], dA, dB, prox)
+        if cand is not None:
+            out.append(cand)
     return out
+
+
+def _promising(
+    ledger: Ledger, labels: np.ndarray, e1: np.ndarray, e2: np.ndarray, ps: PairSpace
+) -> np.ndarray:
+    """``labels`` with the step clusters that cannot shorten the description set to -1.
+
+    A step cluster links pairs ``e1 → e2``; its chains use its distinct pairs and nodes, so
+    they number at least ``nodes - pairs``.
+    """
+    n_lab = int(labels.max()) + 1 if labels.size else 0
+    ok = labels >= 0
+    lab = labels[ok]
+    m = len(ps)
+    pairs = np.unique(np.concatenate([lab * m + e1[ok], lab * m + e2[ok]])) // m
+    n = len(ledger.nodes)
+    nodes = (
+        np.unique(
+            np.concatenate([lab * n + ps.src[e1[ok]], lab * n + ps.dst[e1[ok]], lab * n + ps.dst[e2[ok]]])
+        )
+        // n
+    )
+    n_pairs = np.bincount(pairs, minlength=n_lab)
+    n_nodes = np.bincount(nodes, minlength=n_lab)
+    fam = np.zeros(n_lab, int)
+    fam[lab] = ledger.family[ps.src[e1[ok]]]
+    bound = ledger.bound(fam, n_nodes, np.full(n_lab, -1), np.zeros(n_lab), np.maximum(n_nodes - n_pairs, 1))
+    return np.where(ok & (bound[np.maximum(labels, 0)] > 0.0), labels, -1)
 
 
 def _linear_chains(ctx, sym, ps, e1, e2, dA, dB, prox) -> LinearCandidate | None:

@@ -10,8 +10,13 @@ is not constant in (d, s) and the sequence is missed.  Expressed at the pivot ``
 
 Every two pairs of one rotation cluster give an estimate of ``o``; the estimates are
 clustered by mean shift and a well-supported mode with ``|D|`` comparable to the
-spacing moves the terminal's origin there.  Rings and spirals (``D = 0`` at their
-centre) are left alone: their transforms are constant at any origin.
+spacing moves the terminal's origin there.
+
+When *all* instances of a terminal are turned about one common point (``D = 0``: the
+petals of one flower, the rays of one sun, copies rotated by ``rotate(θ cx cy)``), the
+origin moves to that point: every instance then sits at the same place and differs only by
+its turn, so a ring is written as a pure turn ``P(m) -> A +(360/n) P(m-1)`` and random turns
+are seen for what they are (the same place, nothing to repeat).
 """
 
 from __future__ import annotations
@@ -77,8 +82,33 @@ def _pivot_for(a: np.ndarray, b: np.ndarray, size: float, tol_angle: float, rng)
     return best if abs(best) > 0.05 * size else 0j
 
 
+def _common_pivot(a: np.ndarray, b: np.ndarray, size: float, tolerance: float) -> complex:
+    """The local point all poses ``(a, b)`` map to one place (within ``tolerance``), or 0.
+
+    Solves ``b_i + a_i·o = P`` for ``o`` and ``P`` in the least-squares sense; the poses must
+    turn (or scale) enough for ``o`` to be determined, and ``o`` must be near the shape.
+    """
+    if a.size < 3 or tolerance <= 0:
+        return 0j
+    spread = float(np.sqrt(np.mean(np.abs(a - a.mean()) ** 2)))
+    if spread < 0.05 * float(np.mean(np.abs(a))):
+        return 0j
+    m = np.column_stack([a, -np.ones(a.size, complex)])
+    sol = np.linalg.lstsq(m, -b, rcond=None)[0]
+    o, p = complex(sol[0]), complex(sol[1])
+    if not np.isfinite(o) or np.max(np.abs(b + a * o - p)) > tolerance:
+        return 0j
+    apart = np.max(np.abs(b - b.mean())) > tolerance  # the instances do not share a place yet
+    return o if apart and abs(o) <= 20 * size else 0j
+
+
 def estimate_pivots(
-    inst: Instancing, sizes: np.ndarray, *, tol_angle: float = 1.0, seed: int = 0
+    inst: Instancing,
+    sizes: np.ndarray,
+    *,
+    tol_angle: float = 1.0,
+    tolerance: float = 0.0,
+    seed: int = 0,
 ) -> np.ndarray:
     """Return, per terminal, the local offset of its pivot (0 where the centroid is kept).
 
@@ -90,6 +120,9 @@ def estimate_pivots(
         Radius of each terminal's shape in its local frame.
     tol_angle : float
         Rotations below this (degrees) do not count as turning.
+    tolerance : float
+        Largest distance (document units) between the places a common pivot maps to; 0
+        looks for no common pivot.
     seed : int
         Seed of the vote sampling (results are deterministic).
     """
@@ -97,7 +130,8 @@ def estimate_pivots(
     out = np.zeros(len(inst.terminals), complex)
     for g in range(len(inst.terminals)):
         sel = np.flatnonzero(inst.group == g)
-        if sel.size >= 5:
+        out[g] = _common_pivot(inst.a[sel], inst.b[sel], float(sizes[g]), tolerance)
+        if out[g] == 0 and sel.size >= 5:
             out[g] = _pivot_for(inst.a[sel], inst.b[sel], float(sizes[g]), tol_angle, rng)
     return out
 

@@ -17,7 +17,9 @@ groups of elements.  Each level:
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
+from functools import partial
 
 import numpy as np
 
@@ -25,8 +27,11 @@ from lsys_core.cancel import CancelToken, Progress, check, report
 from lsys_core.grammar.model import Case, Module, Pop, Push, Rule, Symbol
 from lsys_core.hierarchy.analysis import find_candidates
 from lsys_core.hierarchy.candidates import Candidate, SeqCandidate
-from lsys_core.hierarchy.emit import const_t, emit
+from lsys_core.hierarchy.emit import const_t, const_t_many, emit
+from lsys_core.hierarchy.gain import Ledger, placement_error
+from lsys_core.hierarchy.mdl import Precision
 from lsys_core.hierarchy.nodes import Nodes
+from lsys_core.hierarchy.snap import snapped
 from lsys_core.hierarchy.spaces import pair_space
 from lsys_core.hierarchy.symbols import SymbolTable
 from lsys_core.settings import setting
@@ -35,10 +40,10 @@ __all__ = ["Hierarchy", "Tolerance", "Weights", "build_hierarchy"]
 
 #: Levels of the hierarchy at most (each level codes at least one repetition).
 MAX_LEVELS = 100
-#: Scenes with more live nodes than this ignore candidates that repeat only twice (see :func:`_chance`).
-CHANCE_SCENE = 100
+#: Default tolerance, as a share of the drawing's diagonal, when none is given.
+DEFAULT_TOLERANCE = 0.005
 #: A best candidate covering less than this share of the nodes is applied together with all
-#: other candidates on disjoint nodes (see :func:`_batch`).
+#: other candidates on disjoint nodes (see :func:`_choose`).
 WEAK_COVER = 0.05
 
 
@@ -123,6 +128,8 @@ def build_hierarchy(
     weights: Weights = Weights(),
     tol: Tolerance = Tolerance(),
     similarity: np.ndarray | None = None,
+    precision: Precision | None = None,
+    symmetry: np.ndarray | None = None,
     neighbours: int = 24,
     cancel: CancelToken | None = None,
     progress: Progress | None = None,
@@ -142,6 +149,13 @@ def build_hierarchy(
         Importance weights and clustering bandwidths.
     similarity
         Terminal-by-terminal shape similarity in [0, 1] (φ of pairs of different terminals).
+    precision
+        The tolerance and the drawing's size: a rule is written only when it shortens the
+        description (:mod:`lsys_core.hierarchy.mdl`) and derives every node it explains within
+        the tolerance.  Default: :data:`DEFAULT_TOLERANCE` of the drawing's diagonal.
+    symmetry
+        Rotational symmetry order of every terminal (1: none, k: k-fold, 0: continuous), so
+        rotations that do not show are not counted as deviations.
     timer
         If given, seconds spent are added under ``transforms``, ``clustering`` and ``rules``.
 
@@ -155,6 +169,12 @@ def build_hierarchy(
     ctx = _Context(table, tol)
     book = _Book(np.asarray(a).size)
     nodes = Nodes.of_elements(group, a, b, center, radius)
+    prec = precision
+    if prec is None:
+        prec = Precision.of_circles(nodes.center, nodes.radius, 0.0)
+        prec = Precision.of_circles(nodes.center, nodes.radius, DEFAULT_TOLERANCE * prec.diagonal)
+    order = np.ones(nt, int) if symmetry is None else np.asarray(symmetry, int)
+    term_period = np.where(order == 0, -1.0, np.where(order >= 2, 2 * np.pi / np.maximum(order, 1), 0.0))
     n0 = len(nodes)
     level = 0
     clock = timer if timer is not None else {}
@@ -170,23 +190,23 @@ def build_hierarchy(
         t0 = time.perf_counter()
         ps = pair_space(nodes.a, nodes.b, nodes.center, nodes.radius, k=neighbours)
         t1 = time.perf_counter()
-        cands = find_candidates(ctx, nodes.sym, ps, nodes.radius)
+        period = np.concatenate([term_period, np.zeros(len(table) - nt)])
+        ledger = Ledger(prec, nodes, table)
+        cands = find_candidates(ctx, nodes.sym, ps, nodes.radius, ledger)
         t2 = time.perf_counter()
-        applied = False
+        chosen: list[Candidate] = []
         if cands and level < MAX_LEVELS:
             first = nodes.first_members()
             cands = [replace(c, start=float(np.mean([first[g[0]] for g in c.groups]))) for c in cands]
-            scores = _scores(cands, weights)
-            best = _best(cands, scores)
-            if not _chance(cands[best], len(nodes)):
-                chosen = _batch(best, cands, scores, len(nodes))
-                level += 1
-                nodes = _apply_all(table, book, chosen, nodes)
-                applied = True
+            test = partial(_worthwhile, ledger=ledger, nodes=nodes, sizes=table.sizes, period=period)
+            chosen = _choose(cands, weights, len(nodes), test)
+        if chosen:
+            level += 1
+            nodes = _apply_all(table, book, chosen, nodes)
         clock["transforms"] += t1 - t0
         clock["clustering"] += t2 - t1
         clock["rules"] += time.perf_counter() - t2
-        if not applied:
+        if not chosen:
             break
     axiom = _axiom(table, book, nodes)
     report(progress, "rules", 1.0)
@@ -200,9 +220,9 @@ def _axiom(table: SymbolTable, book: _Book, nodes: Nodes) -> tuple[Module, ...]:
     name = table.new_name("Z")
     body: list[Module] = []
     a0, b0 = nodes.a[0], nodes.b[0]
+    moves = const_t_many(nodes.a / a0, (nodes.b - b0) / a0)
     for i in range(len(nodes)):
-        t = const_t(nodes.a[i] / a0, (nodes.b[i] - b0) / a0) if i else ()
-        body += [Push(), *t, *table.draw(int(nodes.sym[i]), last=True), Pop()]
+        body += [Push(), *(moves[i] if i else ()), *table.draw(int(nodes.sym[i]), last=True), Pop()]
     book.add(
         Rule(name, False, (Case(None, tuple(body)),)),
         f"{name}: places the {len(nodes)} remaining nodes",
@@ -234,13 +254,20 @@ def _duplicates(table: SymbolTable, nodes: Nodes) -> list[Candidate]:
     ]
 
 
-def _chance(best: Candidate, n_nodes: int) -> bool:
-    """Whether the best candidate looks like a coincidence in a large scene.
+def _worthwhile(
+    c: Candidate, ledger: Ledger, nodes: Nodes, sizes: np.ndarray, period: np.ndarray
+) -> Candidate | None:
+    """The candidate with its numbers rounded, if it shortens the description within the tolerance.
 
-    Two repetitions of a transform among hundreds of unrelated elements happen by chance;
-    coding them would add rules without describing any structure.
+    This is the minimum description length test (:mod:`lsys_core.hierarchy.mdl`): a transform
+    that repeats by chance among unrelated elements does not pay for its rule.  Its numbers
+    are rounded first (:func:`~lsys_core.hierarchy.snap.snapped`), and the rule, derived from
+    each application's first node, must put every node within the tolerance.
     """
-    return n_nodes > CHANCE_SCENE and best.repeats < 3 and best.covered < WEAK_COVER * n_nodes
+    c = snapped(c, nodes, ledger.prec.eps)
+    if placement_error(c, nodes, sizes, period) > ledger.prec.eps or ledger.gain(c) <= 0.0:
+        return None
+    return c
 
 
 def _scores(cands: list[Candidate], w: Weights) -> np.ndarray:
@@ -252,33 +279,39 @@ def _scores(cands: list[Candidate], w: Weights) -> np.ndarray:
     )
 
 
-def _best(cands: list[Candidate], scores: np.ndarray) -> int:
-    """Index of the most important candidate.
+def _choose(
+    cands: list[Candidate],
+    weights: Weights,
+    n_nodes: int,
+    worthwhile: Callable[[Candidate], Candidate | None],
+) -> list[Candidate]:
+    """The candidates to apply at this level, most important first (§5.4–§5.5).
 
-    Ties (e.g. a sequence read forwards or backwards) go to the order the art was drawn in.
+    Candidates are taken in order of importance (ties, e.g. a sequence read forwards or
+    backwards, go to the order the art was drawn in); the first ``worthwhile`` one is applied.
+    When it covers only a small part of the scene (weak structure among clutter), every other
+    worthwhile candidate on disjoint nodes is applied in the same level, so the number of
+    levels stays small.  Only the candidates looked at are tested.
     """
-    return max(
-        range(len(cands)), key=lambda i: (round(float(scores[i]), 9), cands[i].covered, -cands[i].start)
+    scores = _scores(cands, weights)
+    order = sorted(
+        range(len(cands)),
+        key=lambda i: (round(float(scores[i]), 9), cands[i].covered, -cands[i].start),
+        reverse=True,
     )
-
-
-def _batch(best: int, cands: list[Candidate], scores: np.ndarray, n_nodes: int) -> list[Candidate]:
-    """Return the candidates to apply at this level: the best one, or many weak ones at once.
-
-    When the most important candidate covers only a small part of the scene (chance
-    coincidences among clutter or duplicates), every other candidate on disjoint nodes is
-    applied in the same level, in order of importance, so the number of levels stays small.
-    """
-    if cands[best].covered >= WEAK_COVER * n_nodes:
-        return [cands[best]]
     taken = np.zeros(n_nodes, bool)
-    out = []
-    for i in sorted(range(len(cands)), key=lambda i: -scores[i]):
+    out: list[Candidate] = []
+    for i in order:
         nodes = cands[i].nodes()
         if taken[nodes].any():
             continue
+        c = worthwhile(cands[i])
+        if c is None:
+            continue
         taken[nodes] = True
-        out.append(cands[i])
+        out.append(c)
+        if out[0].covered >= WEAK_COVER * n_nodes:
+            break
     return out
 
 

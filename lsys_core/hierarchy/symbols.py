@@ -88,13 +88,15 @@ class SymbolTable:
         if self._sizes[sid] == 0.0:
             self._sizes[sid] = float(size)
 
+    def ref(self, sid: int) -> Symbol:
+        """The module naming symbol ``sid`` (with its counter)."""
+        s = self.infos[sid]
+        return Symbol(s.name, Count(s.m) if s.m is not None else None)
+
     def draw(self, sid: int, last: bool = False) -> tuple[Module, ...]:
         """Modules that draw symbol ``sid`` without moving the turtle (brackets for non-terminals)."""
-        s = self.infos[sid]
-        if s.terminal:
-            return (Symbol(s.name),)
-        mod = Symbol(s.name, Count(s.m) if s.m is not None else None)
-        return (mod,) if last else (Push(), mod, Pop())
+        mod = self.ref(sid)
+        return (mod,) if last or self.infos[sid].terminal else (Push(), mod, Pop())
 
     def phi(self, si: int, sj: int) -> float:
         """Similarity of two symbols (§5.4): the shapes' φ for terminals, else by family."""

@@ -1,0 +1,281 @@
+"""What a candidate rule would save, in bits, and how far its derivation would move the nodes.
+
+The baseline is the grammar that places every live node one by one (the catch-all rule,
+coded as one set of placements per symbol family, :mod:`lsys_core.hierarchy.mdl`).  Applying a
+candidate takes its nodes out of their sets, adds one placement per application to a new
+set (with its counter), and writes the rule.  The candidate is worth applying only when that
+is shorter (a positive *gain*) and when the rule, derived from each application's first node,
+puts every node within the tolerance of where it was drawn.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lsys_core.geometry.transforms import rel_from_t4
+from lsys_core.grammar.model import Rule
+from lsys_core.hierarchy.candidates import (
+    BranchCandidate,
+    Candidate,
+    LinearCandidate,
+    PairCandidate,
+    SeqCandidate,
+)
+from lsys_core.hierarchy.emit import counters, rule_cases
+from lsys_core.hierarchy.mdl import (
+    KIND_BITS,
+    Precision,
+    count_bits,
+    placement_set_bits,
+    pose_bits,
+    rule_bits,
+    structured_bits,
+    symbol_bits,
+    token_bits,
+    transform_bits,
+)
+from lsys_core.hierarchy.nodes import Nodes
+from lsys_core.hierarchy.symbols import SymbolTable
+
+__all__ = ["Ledger", "cluster_bounds", "group_reach", "placement_error"]
+
+
+class Ledger:
+    """The description of one level's live nodes placed one by one, and the gain of candidates.
+
+    Parameters
+    ----------
+    prec : Precision
+        The precision (tolerance) of the description.
+    nodes : Nodes
+        The live nodes.
+    table : SymbolTable
+        Their symbols.
+    """
+
+    def __init__(self, prec: Precision, nodes: Nodes, table: SymbolTable):
+        self.prec = prec
+        self.nodes = nodes
+        self.table = table
+        fam_of_sym = table.families()
+        self.family = fam_of_sym[nodes.sym]
+        n_fam = int(fam_of_sym.max()) + 1 if fam_of_sym.size else 0
+        self.token = token_bits(n_fam + 1)
+        self.count = np.bincount(self.family, minlength=n_fam)
+        m = np.array([-1 if s.m is None else s.m for s in table.infos])[nodes.sym]
+        self.node_counts = np.where(m >= 0, count_bits(np.maximum(m, 0)), 0.0)
+        self.counts = np.bincount(self.family, self.node_counts, minlength=n_fam)
+        # the cell of every node, numbered per family, and how many nodes of its family share it
+        cell = prec.cell_ids(nodes.b)
+        key = np.unique(np.column_stack([self.family, cell]), axis=0, return_inverse=True)[1].ravel()
+        self.cell = key
+        self.stacked = np.bincount(key)
+        self.key_family = np.zeros(self.stacked.size, int)
+        self.key_family[key] = self.family
+        self.occupied = np.bincount(self.key_family, minlength=n_fam)
+        self.headings = np.zeros(n_fam)
+        self.scale = np.zeros(n_fam)
+        order = np.argsort(self.family, kind="stable")
+        cuts = np.flatnonzero(np.diff(self.family[order])) + 1
+        for grp in np.split(order, cuts):
+            if grp.size:
+                f = int(self.family[grp[0]])
+                lever = np.abs(nodes.center[grp] - nodes.b[grp]) + nodes.radius[grp]
+                self.headings[f], self.scale[f] = prec.pose_model(nodes.a[grp], lever)
+        self.pose = np.array([self._key_pose(f, self.stacked[self.key_family == f]) for f in range(n_fam)])
+
+    def _key_pose(self, f: int, stacks: np.ndarray) -> float:
+        return pose_bits(float(self.headings[f]), float(self.scale[f]), stacks)
+
+    def _family_bits(self, f, n, counts, occupied=None, pose=None):
+        u = self.occupied[f] if occupied is None else occupied
+        p = self.pose[f] if pose is None else pose
+        return placement_set_bits(self.prec, n, occupied=u, pose=p, counts=counts, token=self.token)
+
+    def removal(self, fam: np.ndarray, k: np.ndarray) -> np.ndarray:
+        """Bits saved by taking ``k`` nodes out of the sets of families ``fam``, at best (an upper bound)."""
+        fam = np.asarray(fam, int)
+        n = self.count[fam]
+        k = np.minimum(np.asarray(k), n)
+        u = self.occupied[fam]
+        share = np.where(n > 0, (n - k) / np.maximum(n, 1), 0.0)
+        per = np.log2(np.maximum(self.headings[fam], 1.0)) + self.scale[fam]
+        before = self._family_bits(fam, n, self.counts[fam], u, 0.0)
+        after = self._family_bits(fam, n - k, self.counts[fam] * share, np.maximum(u - k, 0), 0.0)
+        return before - after + k * per
+
+    def bound(
+        self, fam_a: np.ndarray, k_a: np.ndarray, fam_b: np.ndarray, k_b: np.ndarray, groups
+    ) -> np.ndarray:
+        """An optimistic gain: ``k_a``/``k_b`` nodes of families ``fam_a``/``fam_b`` (-1: none) in ``groups``.
+
+        The new set is charged without headings or counters and the rule as one symbol and
+        no numbers, so a candidate whose bound is not positive cannot pay for itself.
+        """
+        saved = self.removal(fam_a, k_a) + np.where(fam_b >= 0, self.removal(np.maximum(fam_b, 0), k_b), 0.0)
+        new = placement_set_bits(self.prec, groups, token=self.token)
+        return saved - new - (self.token + KIND_BITS)
+
+    def gain(self, c: Candidate) -> float:
+        """Bits saved by applying ``c`` (positive: the description gets shorter)."""
+        nodes = c.nodes()
+        fam = self.family[nodes]
+        saved = 0.0
+        removed = np.bincount(self.cell[nodes], minlength=self.stacked.size)
+        left = self.stacked - removed
+        for f in np.unique(fam):
+            f = int(f)
+            taken = fam == f
+            n, k = int(self.count[f]), int(taken.sum())
+            mine = self.key_family == f
+            u = int(np.count_nonzero(left[mine] > 0))
+            before = self._family_bits(f, n, float(self.counts[f]))
+            counts = float(self.counts[f] - self.node_counts[nodes[taken]].sum())
+            saved += before - self._family_bits(f, n - k, counts, u, self._key_pose(f, left[mine]))
+        first = np.array([int(g[0]) for g in c.groups])
+        ms = [m for m in counters(c) if m is not None]
+        _, stacks = np.unique(self.cell[first], return_counts=True)
+        pose = pose_bits(
+            *self.prec.pose_model(self.nodes.a[first], group_reach(self.nodes, c.groups)), stacks
+        )
+        new = placement_set_bits(
+            self.prec,
+            len(c.groups),
+            occupied=stacks.size,
+            pose=pose,
+            counts=float(np.sum(count_bits(ms))) if ms else 0.0,
+            token=self.token,
+        )
+        return saved - new - self.rule_bits(c)
+
+    def rule_bits(self, c: Candidate) -> float:
+        """Bits of the rule candidate ``c`` would write."""
+        si, sj = c.space
+        refs = [symbol_bits(self.token, self.table.ref(si))]
+        if isinstance(c, PairCandidate):
+            refs.append(symbol_bits(self.token, self.table.ref(sj)))
+            return structured_bits(self.prec, self.token, refs, [transform_bits(self.prec, c.A, c.B)])
+        if isinstance(c, SeqCandidate):
+            return structured_bits(self.prec, self.token, refs, [transform_bits(self.prec, c.A, c.B)])
+        if isinstance(c, BranchCandidate):
+            runs = [transform_bits(self.prec, *c.first), transform_bits(self.prec, *c.second)]
+            return structured_bits(self.prec, self.token, refs, runs)
+        return rule_bits(self.prec, self.token, Rule("_", True, rule_cases(self.table, c, "_")))
+
+
+def group_reach(nodes: Nodes, groups: tuple[np.ndarray, ...]) -> np.ndarray:
+    """How far every group's geometry reaches from its first node's origin (the lever of its heading)."""
+    flat = np.concatenate(groups)
+    owner = np.repeat(np.arange(len(groups)), [g.size for g in groups])
+    origin = nodes.b[np.array([int(g[0]) for g in groups])]
+    reach = np.zeros(len(groups))
+    np.maximum.at(reach, owner, np.abs(nodes.center[flat] - origin[owner]) + nodes.radius[flat])
+    return reach
+
+
+def cluster_bounds(ledger: Ledger, labels: np.ndarray, src: np.ndarray, dst: np.ndarray) -> np.ndarray:
+    """The optimistic gain (:meth:`Ledger.bound`) of every cluster of pairs ``src → dst``.
+
+    A cluster of ``c`` pairs on ``u`` distinct nodes of one family forms at least ``u - c``
+    chains; pairs of two families are ``min(sources, targets)`` pairs at most.
+    """
+    n_lab = int(labels.max()) + 1 if labels.size else 0
+    ok = labels >= 0
+    lab, s, d = labels[ok], src[ok], dst[ok]
+    c = np.bincount(lab, minlength=n_lab)
+    n = len(ledger.nodes)
+
+    def distinct(x: np.ndarray) -> np.ndarray:
+        return np.bincount(np.unique(lab * n + x) // n, minlength=n_lab)
+
+    both = np.bincount(np.unique(np.concatenate([lab * n + s, lab * n + d])) // n, minlength=n_lab)
+    n_src, n_dst = distinct(s), distinct(d)
+    fam_s = np.zeros(n_lab, int)
+    fam_d = np.zeros(n_lab, int)
+    fam_s[lab] = ledger.family[s]
+    fam_d[lab] = ledger.family[d]
+    same = fam_s == fam_d
+    pairs = np.minimum(n_src, n_dst)
+    chained = ledger.bound(fam_s, both, np.full(n_lab, -1), np.zeros(n_lab), np.maximum(both - c, 1))
+    paired = ledger.bound(fam_s, pairs, np.where(same, -1, fam_d), pairs, pairs)
+    return np.where(same, np.maximum(chained, paired), paired)
+
+
+def _pose_error(
+    nodes: Nodes, idx: np.ndarray, a_pred: np.ndarray, b_pred: np.ndarray, sizes, period
+) -> float:
+    """Largest displacement (translation plus rotation/scale at the rim) of nodes from predicted poses."""
+    sym = nodes.sym[idx]
+    ratio = nodes.a[idx] / a_pred
+    p = period[sym]
+    ang = np.angle(ratio)
+    ang = np.where(p > 0, ang - np.round(ang / np.where(p > 0, p, 1.0)) * p, ang)
+    ratio = np.where(p < 0, np.abs(ratio), np.abs(ratio) * np.exp(1j * ang))
+    err = np.abs(b_pred - nodes.b[idx]) + np.abs(a_pred) * np.abs(ratio - 1.0) * sizes[sym]
+    return float(err.max()) if err.size else 0.0
+
+
+def _chain_poses(nodes: Nodes, groups, A: complex, B: complex):
+    idx = np.concatenate(groups)
+    first = np.concatenate([np.full(g.size, g[0]) for g in groups])
+    k = np.concatenate([np.arange(g.size) for g in groups]).astype(float)
+    Ak = A**k
+    steps = k if abs(A - 1) < 1e-12 else (Ak - 1.0) / (A - 1.0)
+    a0, b0 = nodes.a[first], nodes.b[first]
+    return idx, a0 * Ak, b0 + a0 * B * steps
+
+
+def _linear_poses(nodes: Nodes, c: LinearCandidate):
+    g = np.array([grp for grp in c.groups])  # all of one length: steps + 1
+    a = nodes.a[g[:, 0]].copy()
+    b = nodes.b[g[:, 0]].copy()
+    pa, pb = [a.copy()], [b.copy()]
+    for j in range(g.shape[1] - 1):
+        A, B = rel_from_t4(c.alpha0 + j * c.d_alpha, c.d, c.s, c.beta0 + j * c.d_beta)
+        a, b = a * complex(A), b + a * complex(B)
+        pa.append(a.copy())
+        pb.append(b.copy())
+    return g.ravel(), np.stack(pa, axis=1).ravel(), np.stack(pb, axis=1).ravel()
+
+
+def _tree_poses(nodes: Nodes, c: BranchCandidate):
+    (A1, B1), (A2, B2) = c.first, c.second
+    idx, pa, pb = [], [], []
+    for tree, depth in zip(c.groups, c.depths, strict=True):
+        a = nodes.a[tree[:1]]
+        b = nodes.b[tree[:1]]
+        start = 0
+        for level in range(depth + 1):
+            width = 1 << level
+            idx.append(tree[start : start + width])
+            pa.append(a)
+            pb.append(b)
+            start += width
+            a, b = np.concatenate([a * A1, a * A2]), np.concatenate([b + a * B1, b + a * B2])
+    return np.concatenate(idx), np.concatenate(pa), np.concatenate(pb)
+
+
+def placement_error(c: Candidate, nodes: Nodes, sizes: np.ndarray, period: np.ndarray) -> float:
+    """Largest distance between a node and where the candidate's rule would derive it.
+
+    Parameters
+    ----------
+    c : Candidate
+        The candidate.
+    nodes : Nodes
+        The live nodes.
+    sizes : ndarray
+        Radius of every symbol in its own frame.
+    period : ndarray
+        Per symbol, the rotation (radians) that maps its shape onto itself: 0 for none,
+        negative for any rotation (a circle).
+    """
+    if isinstance(c, (SeqCandidate, PairCandidate)):
+        idx, pa, pb = _chain_poses(nodes, c.groups, c.A, c.B)
+    elif isinstance(c, LinearCandidate):
+        idx, pa, pb = _linear_poses(nodes, c)
+    elif isinstance(c, BranchCandidate):
+        idx, pa, pb = _tree_poses(nodes, c)
+    else:  # pragma: no cover
+        raise TypeError(f"unknown candidate {type(c).__name__}")
+    return _pose_error(nodes, idx, pa, pb, sizes, period)

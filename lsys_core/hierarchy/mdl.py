@@ -1,0 +1,449 @@
+"""Description length of grammars, in bits (minimum description length, MDL).
+
+The inference keeps a rule only when the grammar with it is *shorter* than the grammar
+without it — Rissanen's minimum description length principle (J. Rissanen, "Modeling by
+shortest data description", Automatica 14, 1978), which inverse procedural modeling uses to
+choose among grammars (e.g. Talton et al., "Learning design patterns with Bayesian grammar
+induction", UIST 2012; Martinović and Van Gool, "Bayesian grammar learning for inverse
+procedural modeling", CVPR 2013).  A rule that merely restates chance coincidences does not
+shorten the description and is not written.
+
+The code used here counts what a grammar must say, at the precision the user's tolerance
+``eps`` (a length) implies:
+
+* a number is worth ``log2(range / precision)`` bits: a distance ``log2(2·D/eps)`` (``D`` the
+  drawing's diagonal), an angle ``log2(2π·D/eps)`` (a turn moves the far end of the drawing
+  by at most ``eps``), a scale ``log2(2·ln 100·D/eps)``; a counter ``m`` costs ``2·log2(m+1)+1``
+  (Elias' gamma code); naming a symbol costs ``log2 K`` bits, ``K`` the size of the alphabet
+  (symbols plus turtle commands), a turtle command 2 bits;
+* a rule of one of the paper's kinds (a pair ``X T Y``, a sequence r1/r2, a branching r3/r4) is
+  coded by its kind, the symbols it repeats and its transform's numbers; any other rule token
+  by token;
+* elements placed one by one (the catch-all rule) are coded as *sets*: ``N`` placements of
+  one symbol among the ``C = area/eps²`` cells of the drawing cost ``log2 binom(C, N)``
+  (their order carries no information), plus a heading and a scale each when they vary
+  within the set.  With this code ``N`` random placements cannot be shortened by chance
+  pairs: coding the pairs as a set of their own costs more than they save.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.special import gammaln
+
+from lsys_core.grammar.model import Case, Count, Grammar, Module, Pop, Push, Rule, Symbol, Turtle
+
+__all__ = [
+    "Precision",
+    "count_bits",
+    "grammar_bits",
+    "log2_binom",
+    "placement_set_bits",
+    "pose_bits",
+    "rule_bits",
+    "shape_bits",
+    "structured_bits",
+    "symbol_bits",
+    "token_bits",
+    "transform_bits",
+]
+
+#: Tokens besides symbols: the turtle commands ``f + - *``, brackets and the two conditions.
+COMMANDS = 8
+#: Bits naming the kind of a rule (pair, sequence, branching, other).
+KIND_BITS = 2.0
+#: Bits of a turtle command's operator, of a bracket, of a condition and of a self-reference ``P(m-1)``.
+OP_BITS = 2.0
+#: Scales are coded as ``ln s`` in ``[-ln 100, ln 100]``.
+_LOG_SCALE_RANGE = 2.0 * math.log(100.0)
+#: A placement's heading or scale "varies" within a set when it moves the shape's rim by more than
+#: this share of the tolerance.
+_VARY = 0.5
+
+
+@dataclass(frozen=True)
+class Precision:
+    """The precision a description is written at: the tolerance ``eps`` in a drawing of a given size.
+
+    Attributes
+    ----------
+    eps : float
+        The tolerance, a length in document units (> 0).
+    diagonal : float
+        Diagonal of the drawing's bounding box.
+    area : float
+        Area of the drawing's bounding box.
+    """
+
+    eps: float
+    diagonal: float
+    area: float
+
+    @classmethod
+    def of_circles(cls, center: np.ndarray, radius: np.ndarray, eps: float) -> Precision:
+        """The precision for a drawing given as bounding circles of its elements."""
+        lo_x, hi_x = np.min(center.real - radius), np.max(center.real + radius)
+        lo_y, hi_y = np.min(center.imag - radius), np.max(center.imag + radius)
+        w, h = float(hi_x - lo_x), float(hi_y - lo_y)
+        diag = max(math.hypot(w, h), 1e-12)
+        eps = min(max(float(eps), 1e-9 * diag), diag)
+        return cls(eps, diag, max(w, eps) * max(h, eps))
+
+    def relaxed(self, eps: float) -> Precision:
+        """The same drawing at another tolerance."""
+        return Precision(min(max(float(eps), 1e-9 * self.diagonal), self.diagonal), self.diagonal, self.area)
+
+    @property
+    def cells(self) -> float:
+        """Places an element can be put at: the drawing's area in ``eps``-sized cells."""
+        return max(self.area / self.eps**2, 2.0)
+
+    @property
+    def length_bits(self) -> float:
+        """Bits of a signed distance."""
+        return math.log2(2.0 * self.diagonal / self.eps + 1.0)
+
+    def angle_bits(self, lever: float | None = None) -> float:
+        """Bits of an angle: its turn moves points ``lever`` away (default: the diagonal) by ``eps`` at most."""
+        return math.log2(2.0 * math.pi * (self.diagonal if lever is None else lever) / self.eps + 1.0)
+
+    def scale_bits(self, lever: float | None = None) -> float:
+        """Bits of a scale factor (coded as its logarithm), for shapes of radius ``lever``."""
+        return math.log2(_LOG_SCALE_RANGE * (self.diagonal if lever is None else lever) / self.eps + 1.0)
+
+    def cell_ids(self, z: np.ndarray) -> np.ndarray:
+        """The ``eps``-sized grid cell of every point ``z`` (one integer each)."""
+        z = np.asarray(z, complex) / self.eps
+        q = np.column_stack([np.floor(z.real), np.floor(z.imag)])
+        return np.unique(q, axis=0, return_inverse=True)[1].ravel()
+
+    def varies(self, a: np.ndarray, lever: np.ndarray) -> tuple[bool, bool]:
+        """Whether the headings and the scales of poses ``a`` differ visibly (shapes of radius ``lever``)."""
+        if a.size < 2:
+            return False, False
+        unit = a / np.maximum(np.abs(a), 1e-300)
+        mean = np.mean(unit)
+        mean = mean / abs(mean) if abs(mean) > 1e-12 else 1.0
+        turn = float(np.max(np.abs(unit - mean) * lever))
+        ls = np.log(np.maximum(np.abs(a), 1e-300))
+        scale = float(np.max(np.abs(ls - np.mean(ls)) * lever))
+        return turn > _VARY * self.eps, scale > _VARY * self.eps
+
+    def pose_model(self, a: np.ndarray, lever: np.ndarray) -> tuple[float, float]:
+        """How the headings and scales of poses ``a`` (shapes reaching ``lever`` from their origin) are coded.
+
+        Returns the number of distinguishable headings (0 when all are alike, so none is
+        written) and the bits of every scale (0 when all are alike).
+        """
+        turns, scales = self.varies(a, lever)
+        size = float(np.median(lever)) if np.size(lever) else 0.0
+        headings = 2.0 * math.pi * size / self.eps + 1.0 if turns else 0.0
+        return headings, (self.scale_bits(size) if scales else 0.0)
+
+
+def pose_bits(headings: float, scale: float, stacks) -> float:
+    """Bits of the headings and scales of placements stacked ``stacks[i]`` to a cell.
+
+    Placements at one place are told apart by their headings alone, so those form a set:
+    ``log2 C(headings, k)`` for a stack of ``k`` (its order carries no information).
+    """
+    k = np.asarray(stacks, dtype=float)
+    bits = float(np.sum(k)) * scale
+    if headings > 0:
+        bits += float(np.sum(log2_binom(np.maximum(headings, k), k)))
+    return bits
+
+
+def log2_binom(n: float, k):
+    """``log2`` of the binomial coefficient ``C(n, k)`` (real ``n``; ``k`` scalar or array)."""
+    k = np.asarray(k, dtype=float)
+    return (gammaln(n + 1.0) - gammaln(k + 1.0) - gammaln(n - k + 1.0)) / math.log(2.0)
+
+
+def count_bits(m) -> np.ndarray:
+    """Bits of counters ``m >= 0``: Elias' gamma code of ``m + 1``, ``2·floor(log2(m+1)) + 1``."""
+    return 2.0 * np.floor(np.log2(np.asarray(m, dtype=float) + 1.0)) + 1.0
+
+
+def token_bits(n_symbols: int) -> float:
+    """Bits naming one symbol of an alphabet of ``n_symbols`` terminals and non-terminals."""
+    return math.log2(n_symbols + COMMANDS)
+
+
+def placement_set_bits(prec: Precision, n, *, occupied=None, pose=0.0, counts=0.0, token: float = 0.0):
+    """Bits of ``n`` placements of one symbol as a set (vectorised over arrays of ``n``).
+
+    The placements occupy ``occupied`` distinct cells (default: ``n``, all apart); the code
+    names those cells, then how many placements share each (a composition of ``n``).
+
+    Parameters
+    ----------
+    prec : Precision
+        The precision.
+    n : int or ndarray
+        Number of placements (0 costs nothing).
+    occupied : int or ndarray, optional
+        Number of distinct cells they occupy.
+    pose : float or ndarray
+        Bits of all their headings and scales (:func:`pose_bits`).
+    counts : float or ndarray
+        Bits of the placements' counters, if the symbol takes one.
+    token : float
+        Bits naming the symbol once.
+    """
+    n = np.asarray(n, dtype=float)
+    u = n if occupied is None else np.clip(np.asarray(occupied, dtype=float), np.minimum(n, 1.0), n)
+    cells = np.maximum(prec.cells, 2.0 * u)
+    stack = np.where(u < n, log2_binom(np.maximum(n - 1.0, 0.0), np.maximum(u - 1.0, 0.0)), 0.0)
+    bits = token + log2_binom(cells, u) + stack + counts + pose
+    out = np.where(n > 0, bits, 0.0)
+    return float(out) if out.ndim == 0 else out
+
+
+def shape_bits(prec: Precision, n_segments, radius) -> np.ndarray:
+    """Bits of shapes drawn with ``n_segments`` cubic segments inside a circle of ``radius``.
+
+    Three new control points per segment, each coordinate at the precision ``eps``.
+    """
+    per = np.log2(2.0 * np.asarray(radius, float) / prec.eps + 2.0)
+    return 6.0 * np.asarray(n_segments, float) * per
+
+
+def angle_value_bits(prec: Precision, degrees: float) -> float:
+    """Bits of an angle parameter of a rule: a simple fraction ``360·j/k`` of a turn is cheap.
+
+    Designers divide the circle evenly (a ring of 5 turns by 72°); such a step costs the bits of
+    its fraction (``2·log2 k + 1``) instead of the full precision, when it is the fraction to
+    within the precision.
+    """
+    full = prec.angle_bits()
+    tol = math.degrees(prec.eps / prec.diagonal)
+    for k in range(1, 25):
+        j = round(degrees * k / 360.0)
+        if j != 0 and abs(degrees - 360.0 * j / k) <= tol:
+            return min(full, 2.0 * math.log2(k) + 1.0 + math.log2(abs(j) + 1.0))
+    return full
+
+
+def transform_bits(prec: Precision, A: complex, B: complex) -> float:
+    """Bits of a rule's constant transform ``(A, B)``: offset, turn and scale, each with a flag.
+
+    Components that are zero (no offset along an axis, no turn, scale 1) cost only their flag.
+    """
+    tiny = 1e-6 * prec.diagonal
+    bits = 4.0
+    for v in (B.real, B.imag):
+        if abs(v) > tiny:
+            bits += prec.length_bits
+    turn = math.degrees(float(np.angle(A)))
+    if abs(turn) > 1e-6:
+        bits += angle_value_bits(prec, turn)
+    if abs(math.log(max(abs(A), 1e-300))) > 1e-7:
+        bits += prec.scale_bits()
+    return bits
+
+
+def _turtle_bits(prec: Precision, t: Turtle) -> float:
+    def number(v: float) -> float:
+        if t.op == "f":
+            return prec.length_bits
+        return prec.scale_bits() if t.op == "*" else angle_value_bits(prec, v)
+
+    return (
+        OP_BITS
+        + (number(t.value.c0) if t.value.c0 != 0 else 0.0)
+        + (number(t.value.cd) if t.value.cd != 0 else 0.0)
+    )
+
+
+def run_bits(prec: Precision, turtles: list[Turtle]) -> float:
+    """Bits of the turtle commands between two symbols: as one transform when constant."""
+    frame = compose(turtles)
+    if frame is None:
+        return sum(_turtle_bits(prec, t) for t in turtles)
+    return transform_bits(prec, *frame)
+
+
+def compose(turtles: list[Turtle]) -> tuple[complex, complex] | None:
+    """The relative frame ``(A, B)`` of constant turtle commands (None if one depends on ``m``)."""
+    a, b = 1 + 0j, 0j
+    for t in turtles:
+        if t.value.cd != 0:
+            return None
+        v = t.value.c0
+        if t.op == "f":
+            b += a * v
+        elif t.op == "*":
+            a *= v
+        else:
+            a *= complex(np.exp(1j * np.deg2rad(v if t.op == "+" else -v)))
+    return a, b
+
+
+def _symbol_bits(token: float, s: Symbol, name: str) -> float:
+    if s.arg is None:
+        return token
+    if s.arg.k1 != 0:
+        return (
+            OP_BITS
+            if s.name == name and s.arg == Count(-1, 1)
+            else token + OP_BITS + float(count_bits(abs(s.arg.k0)))
+        )
+    return token + float(count_bits(max(s.arg.k0, 0)))
+
+
+def _token_code(prec: Precision, token: float, rule: Rule) -> float:
+    bits = 0.0  # rules are numbered: a rule's own name costs nothing
+    for c in rule.cases:
+        bits += OP_BITS if c.cond is not None else 0.0
+        for m in c.body:
+            if isinstance(m, Turtle):
+                bits += _turtle_bits(prec, m)
+            elif isinstance(m, Symbol):
+                bits += _symbol_bits(token, m, rule.name)
+            else:
+                bits += OP_BITS
+    return bits
+
+
+def _drawn(body: tuple[Module, ...], i: int) -> tuple[Symbol, int] | None:
+    """The symbol drawn at ``body[i]`` (``A`` or ``[ A ]``) and the index after it."""
+    if i < len(body) and isinstance(body[i], Symbol):
+        s = body[i]
+        assert isinstance(s, Symbol)
+        return s, i + 1
+    if i + 2 < len(body) and isinstance(body[i], Push) and isinstance(body[i + 2], Pop):
+        s = body[i + 1]
+        return (s, i + 3) if isinstance(s, Symbol) else None
+    return None
+
+
+def _turtles(body: tuple[Module, ...], i: int) -> tuple[list[Turtle], int]:
+    out = []
+    while i < len(body) and isinstance(body[i], Turtle):
+        t = body[i]
+        assert isinstance(t, Turtle)
+        out.append(t)
+        i += 1
+    return out, i
+
+
+def _structure(rule: Rule) -> tuple[list[Symbol], list[list[Turtle]]] | None:
+    """The symbols and the turtle runs of a rule of one of the paper's kinds, or None."""
+    body = rule.cases[0].body
+    head = _drawn(body, 0)
+    if head is None:
+        return None
+    first, i = head
+    if not rule.parametric and len(rule.cases) == 1:
+        ts, i = _turtles(body, i)
+        tail = _drawn(body, i)
+        return ([first, tail[0]], [ts]) if tail is not None and tail[1] == len(body) else None
+    if not rule.parametric or len(rule.cases) != 2:
+        return None
+    end = _drawn(rule.cases[1].body, 0)
+    if end is None or end[0] != first or end[1] != len(rule.cases[1].body):
+        return None
+    me = Symbol(rule.name, Count(-1, 1))
+    if i < len(body) and isinstance(body[i], Push):  # branching: [A] [T1 R(m-1)] T2 R(m-1)
+        t1, j = _turtles(body, i + 1)
+        if j + 1 >= len(body) or body[j] != me or not isinstance(body[j + 1], Pop):
+            return None
+        t2, k = _turtles(body, j + 2)
+        return ([first], [t1, t2]) if k + 1 == len(body) and body[k] == me else None
+    ts, j = _turtles(body, i)
+    return ([first], [ts]) if j + 1 == len(body) and body[j] == me else None
+
+
+def structured_bits(prec: Precision, token: float, refs: list[float], runs: list[float]) -> float:
+    """Bits of a rule of one of the paper's kinds: kind, symbols repeated and transforms."""
+    return KIND_BITS + sum(refs) + sum(runs)
+
+
+def symbol_bits(token: float, s: Symbol) -> float:
+    """Bits of a reference to symbol ``s`` with its counter."""
+    return _symbol_bits(token, s, "")
+
+
+def rule_bits(prec: Precision, token: float, rule: Rule) -> float:
+    """Bits of one rule: by kind, symbols and numbers for the paper's kinds, else token by token."""
+    bits = _token_code(prec, token, rule)
+    found = _structure(rule)
+    if found is not None:
+        syms, runs = found
+        refs = [_symbol_bits(token, s, rule.name) for s in syms]
+        bits = min(bits, structured_bits(prec, token, refs, [run_bits(prec, r) for r in runs]))
+    return bits
+
+
+def _placements(body: tuple[Module, ...]) -> list[tuple[Symbol, complex, complex]] | None:
+    """The body as placements ``[ turtle… Symbol ]`` with their relative frames, or None if it is not one."""
+    out = []
+    i = 0
+    while i < len(body):
+        if not isinstance(body[i], Push):
+            return None
+        ts, i = _turtles(body, i + 1)
+        frame = compose(ts)
+        if (
+            frame is None
+            or i + 1 >= len(body)
+            or not isinstance(body[i], Symbol)
+            or not isinstance(body[i + 1], Pop)
+        ):
+            return None
+        sym = body[i]
+        assert isinstance(sym, Symbol)
+        out.append((sym, frame[0], frame[1]))
+        i += 2
+    return out if len(out) >= 2 else None
+
+
+def _set_code(
+    prec: Precision, token: float, items: list[tuple[Symbol, complex, complex]], radius: dict[str, float]
+) -> float:
+    by_name: dict[str, list[tuple[Symbol, complex, complex]]] = {}
+    for it in items:
+        by_name.setdefault(it[0].name, []).append(it)
+    bits = OP_BITS
+    for name, group in by_name.items():
+        a = np.array([g[1] for g in group])
+        lever = radius.get(name, prec.diagonal) * np.abs(a)
+        counts = sum(float(count_bits(max(g[0].arg.k0, 0))) for g in group if g[0].arg is not None)
+        _, stacks = np.unique(prec.cell_ids(np.array([g[2] for g in group])), return_counts=True)
+        pose = pose_bits(*prec.pose_model(a, lever), stacks)
+        bits += placement_set_bits(
+            prec, len(group), occupied=stacks.size, pose=pose, counts=counts, token=token
+        )
+    return bits
+
+
+def grammar_bits(g: Grammar, prec: Precision, *, shapes: bool = True) -> float:
+    """Description length of a grammar, in bits, at precision ``prec`` (see the module docstring).
+
+    A body that only places symbols (``[T A] [T B] …``) is charged the cheaper of the token
+    code and the set code.  With ``shapes``, the terminals' path data counts too.
+    """
+    from lsys_core.geometry.paths import cubics_from_d
+
+    token = token_bits(len(g.terminals) + len(g.rules))
+    radius: dict[str, float] = {}
+    bits = 0.0
+    for t in g.terminals:
+        cubics, _, _ = cubics_from_d(t.path)
+        if cubics.size:
+            radius[t.name] = float(np.max(np.abs(cubics - cubics.mean())))
+            if shapes:
+                bits += float(shape_bits(prec, cubics.shape[0], radius[t.name]))
+    bits += _token_code(prec, token, Rule("", False, (Case(None, g.axiom),)))
+    for r in g.rules:
+        rule = rule_bits(prec, token, r)
+        if len(r.cases) == 1:
+            items = _placements(r.cases[0].body)
+            if items is not None:
+                rule = min(rule, _set_code(prec, token, items, radius))
+        bits += rule
+    return float(bits)

@@ -1,0 +1,79 @@
+"""Round a candidate's numbers to the simplest values the tolerance allows.
+
+A measured transform carries the noise of the drawing: ``+(89.59842) f(-0.0000992)
+*(0.9999986) +(-134.59842)`` is a turn by -45° about the shape's origin.  Every number is
+replaced by the decimal with the fewest digits within the precision its place in the rule
+needs, so that the derivation of the whole candidate moves no node by more than a tenth of
+the tolerance (angles and scales act at the candidate's reach, and every step compounds
+over the longest application).  Offsets shorter than that precision vanish, and with them
+the heading of the offset: what is left is written as the designer would write it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+from lsys_core.geometry.transforms import rel_from_t4, t4_from_rel
+from lsys_core.hierarchy.candidates import (
+    BranchCandidate,
+    Candidate,
+    LinearCandidate,
+    PairCandidate,
+    SeqCandidate,
+)
+from lsys_core.hierarchy.emit import nice
+from lsys_core.hierarchy.gain import group_reach
+from lsys_core.hierarchy.nodes import Nodes
+
+__all__ = ["snapped"]
+
+#: Share of the tolerance the rounding of one candidate may spend.
+_SHARE = 0.1
+
+
+def _snap_transform(
+    A: complex, B: complex, length: float, angle: float, scale: float
+) -> tuple[complex, complex]:
+    al, d, s, be = (float(v) for v in t4_from_rel(A, B))
+    if d <= length:
+        be, al, d = be + al, 0.0, 0.0
+    al = nice(al, abs_tol=angle)
+    be = nice(float((be + 180.0) % 360.0 - 180.0), abs_tol=angle)
+    d = nice(d, abs_tol=length)
+    s = nice(s, abs_tol=scale)
+    A2, B2 = rel_from_t4(al, d, s, be)
+    return complex(A2), complex(B2)
+
+
+def snapped(c: Candidate, nodes: Nodes, eps: float) -> Candidate:
+    """Return ``c`` with its numbers rounded within the tolerance ``eps`` (see the module docstring)."""
+    steps = max(max(int(g.size) for g in c.groups) - 1, 1)
+    if isinstance(c, BranchCandidate):
+        steps = max(c.depths) + 1
+    budget = _SHARE * eps / steps
+    reach = max(float(group_reach(nodes, c.groups).max()), 1e-12)
+    length = budget
+    angle = math.degrees(budget / reach)
+    scale = budget / reach
+    if isinstance(c, (SeqCandidate, PairCandidate)):
+        A, B = _snap_transform(c.A, c.B, length, angle, scale)
+        return replace(c, A=A, B=B)
+    if isinstance(c, BranchCandidate):
+        return replace(
+            c,
+            first=_snap_transform(*c.first, length, angle, scale),
+            second=_snap_transform(*c.second, length, angle, scale),
+        )
+    if isinstance(c, LinearCandidate):
+        slope = angle / steps
+        return replace(
+            c,
+            alpha0=nice(c.alpha0, abs_tol=angle),
+            d=nice(c.d, abs_tol=length),
+            s=nice(c.s, abs_tol=scale),
+            beta0=nice(c.beta0, abs_tol=angle),
+            d_alpha=nice(c.d_alpha, abs_tol=slope),
+            d_beta=nice(c.d_beta, abs_tol=slope),
+        )
+    return c
