@@ -148,7 +148,7 @@ def test_symmetrize_is_one_undoable_step(window, corpus, wait_idle):
 
 
 def test_symmetrize_and_reinfer_that_change_nothing_push_no_step_and_say_why(window, corpus, wait_idle):
-    window.open_path(str(corpus("facade_jitter.svg")))  # already as regular as symmetrize makes it
+    window.open_path(str(corpus("helix.svg")))  # exact: inferred as regular as symmetrize makes it
     wait_idle(window)
     doc = window.doc
     before = doc.text
