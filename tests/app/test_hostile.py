@@ -188,7 +188,15 @@ def test_unreadable_svg_shows_one_line_and_window_stays_usable(
     _assert_usable(window, qtbot, wait_idle)
 
 
-@pytest.mark.parametrize("name", sorted(SVG_OK))
+def _svg_ok_params():
+    """The SVG_OK names; heavy ones are ``slow`` with a pytest time-out above their inference wait."""
+    for name in sorted(SVG_OK):
+        wait_ms = SLOW_SVGS.get(name)
+        marks = [pytest.mark.slow, pytest.mark.timeout(wait_ms / 1000 + 300)] if wait_ms else []
+        yield pytest.param(name, id=name, marks=marks)
+
+
+@pytest.mark.parametrize("name", list(_svg_ok_params()))
 def test_odd_but_readable_svg_is_inferred_and_drawn(
     name, window, tmp_path, qtbot, wait_idle, no_logged_errors
 ):

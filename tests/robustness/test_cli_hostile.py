@@ -33,6 +33,9 @@ MEMORY_LIMIT = 2 << 30
 # A hang guard, not a speed check: far above the slowest case's time on a loaded 2-core machine
 # (about 27 s for overlapping_3000 before MDL).  Speed is measured by ``make bench``.
 TIMEOUT = 600.0
+#: Cases that take about half a minute of CPU alone: marked ``slow`` (``make test`` still runs them;
+#: ``-m "not slow"`` skips them for a quick check), with a pytest time-out above the hang guard.
+SLOW_CASES = frozenset({"svg-overlapping_3000"})
 PRECIOUS = b"precious work \x00\xff that must survive\n"
 GOOD_RULES = (ROOT / "tests" / "data" / "helix_truth.lsys").read_text(encoding="utf-8")
 SVG_OUTPUTS = ("r.lsys", "o.svg", "o.png", "rep.json")
@@ -317,6 +320,8 @@ def _check_outputs_written(case: Case, res: Result) -> None:
 def _params():
     for c in CASES:
         marks = [pytest.mark.xfail(strict=False, reason=c.xfail)] if c.xfail else []
+        if c.name in SLOW_CASES:
+            marks += [pytest.mark.slow, pytest.mark.timeout(TIMEOUT + 300)]
         yield pytest.param(c, id=c.name, marks=marks)
 
 
