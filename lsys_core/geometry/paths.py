@@ -11,20 +11,24 @@ already ends there), so the segments alone describe the outline.
 
 from __future__ import annotations
 
-import re
 from typing import NamedTuple
 
 import numpy as np
 
 from lsys_core.errors import SvgError
+from lsys_core.geometry import pathdata as pd
+from lsys_core.geometry.pathdata import PathTable, parse_path
 
 __all__ = [
+    "ArrayPath",
     "RawPath",
+    "arc_cubics",
     "assemble",
     "cubics_from_d",
     "cubics_from_path",
+    "cubics_from_table",
     "d_from_cubics",
-    "raw_from_d",
+    "path_from_d",
     "raw_from_segments",
 ]
 
@@ -154,112 +158,22 @@ def raw_from_segments(path) -> RawPath:
     return raw
 
 
-_ARITY = {"M": 2, "L": 2, "H": 1, "V": 1, "C": 6, "S": 4, "Q": 4, "T": 2, "Z": 0}
-_NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
-_TOKEN = re.compile(rf"[MmZzLlHhVvCcSsQqTt]|{_NUM}")
-_SEPARATORS = str.maketrans("", "", " \t\r\n\f,")
+class ArrayPath(NamedTuple):
+    """One path as cubic arrays: ``cubics`` (k, 4), ``subpaths`` (k,) and ``closed`` per subpath."""
+
+    cubics: np.ndarray
+    subpaths: np.ndarray
+    closed: tuple[bool, ...]
 
 
-def raw_from_d(d: str) -> RawPath | None:
-    """Parse path data without arcs quickly; return None if svgelements must do it.
-
-    None is returned for data with arc commands and for malformed data (which
-    svgelements renders up to the first error, as SVG asks).
-    """
-    if "a" in d or "A" in d:
-        return None
-    tokens = _TOKEN.findall(d)
-    if _TOKEN.sub("", d).translate(_SEPARATORS):
-        return None  # stray characters
-    raw = RawPath([], [], [], [])
-    kinds, pts, subs, closed = raw
-    cur = start = 0j
-    pending = True
-    cmd = ""
-    started = False
-    rel = False
-    need = 0
-    args: list[float] = []
-    prev_c2: complex | None = None  # last cubic control point (for S)
-    prev_q: complex | None = None  # last quadratic control point (for T)
-    for tok in tokens:
-        if tok.isalpha():
-            if args or (not started and tok not in "Mm"):
-                return None  # incomplete arguments, or data not starting with M
-            started = True
-            up = tok.upper()
-            rel = tok != up
-            cmd, need = up, _ARITY[up]
-            if cmd != "Z":
-                continue
-        else:
-            if not cmd or cmd == "Z":
-                return None  # a number without a command
-            args.append(float(tok))
-            if len(args) < need:
-                continue
-        # Execute one command with its arguments.
-        base = cur if rel else 0j
-        c2 = q = None
-        if cmd == "Z":
-            if not pending:
-                _close(raw, cur, start)
-            cur = start
-            pending = True
-            cmd = ""
-            prev_c2 = prev_q = None
-            continue
-        if cmd == "M":
-            cur = start = base + complex(args[0], args[1])
-            pending = True
-            cmd = "L"  # further pairs are implicit lines
-            args = []
-            prev_c2 = prev_q = None
-            continue
-        if cmd == "L":
-            p3 = base + complex(args[0], args[1])
-            row, code = (cur, cur, p3, p3), _LINE
-        elif cmd == "H":
-            p3 = complex(args[0] + (cur.real if rel else 0.0), cur.imag)
-            row, code = (cur, cur, p3, p3), _LINE
-        elif cmd == "V":
-            p3 = complex(cur.real, args[0] + (cur.imag if rel else 0.0))
-            row, code = (cur, cur, p3, p3), _LINE
-        elif cmd == "C":
-            c1 = base + complex(args[0], args[1])
-            c2 = base + complex(args[2], args[3])
-            p3 = base + complex(args[4], args[5])
-            row, code = (cur, c1, c2, p3), _CUBIC
-        elif cmd == "S":
-            c1 = 2 * cur - prev_c2 if prev_c2 is not None else cur
-            c2 = base + complex(args[0], args[1])
-            p3 = base + complex(args[2], args[3])
-            row, code = (cur, c1, c2, p3), _CUBIC
-        elif cmd == "Q":
-            q = base + complex(args[0], args[1])
-            p3 = base + complex(args[2], args[3])
-            row, code = (cur, q, q, p3), _QUAD
-        else:  # T
-            q = 2 * cur - prev_q if prev_q is not None else cur
-            p3 = base + complex(args[0], args[1])
-            row, code = (cur, q, q, p3), _QUAD
-        args = []
-        prev_c2, prev_q = c2, q
-        if not (row[0] == row[1] == row[2] == row[3]):
-            if pending:
-                closed.append(False)
-                pending = False
-            kinds.append(code)
-            pts.append(row)
-            subs.append(len(closed) - 1)
-        cur = p3
-    if args:
-        return None  # truncated arguments
-    return raw
+def path_from_d(d: str) -> tuple[ArrayPath, str | None]:
+    """Parse path data leniently, as SVG draws it: up to the first error; return the error too."""
+    table = parse_path(d)
+    return ArrayPath(*cubics_from_table(table)), table.error
 
 
-def assemble(raws: list[RawPath]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Convert collected paths to one cubic array.
+def assemble(paths: list[ArrayPath]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Concatenate paths into one cubic array.
 
     Returns
     -------
@@ -267,30 +181,23 @@ def assemble(raws: list[RawPath]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         The segments of all paths, one after another.
     subpaths : ndarray of int, shape (K,)
         Subpath of each segment within its own path.
-    counts : ndarray of int, shape (len(raws),)
+    counts : ndarray of int, shape (len(paths),)
         Number of segments of each path.
     """
-    counts = np.fromiter((len(r.pts) for r in raws), dtype=np.intp, count=len(raws))
-    total = int(counts.sum())
-    if total == 0:
+    counts = np.fromiter((p.cubics.shape[0] for p in paths), dtype=np.intp, count=len(paths))
+    if int(counts.sum()) == 0:
         return np.zeros((0, 4), dtype=complex), np.zeros(0, dtype=np.intp), counts
-    pts: list = []
-    kinds: list = []
-    subs: list = []
-    for r in raws:
-        pts += r.pts
-        kinds += r.kinds
-        subs += r.subs
-    cubics = np.array(pts, dtype=complex).reshape(total, 4)
-    _elevate(cubics, np.array(kinds, dtype=np.int8))
-    return cubics, np.array(subs, dtype=np.intp), counts
+    cubics = np.concatenate([p.cubics for p in paths])
+    subpaths = np.concatenate([p.subpaths for p in paths]).astype(np.intp)
+    return cubics, subpaths, counts
 
 
 def _to_arrays(raw: RawPath) -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
     if not raw.pts:
         return _empty()
-    cubics, subpaths, _ = assemble([raw])
-    return cubics, subpaths, tuple(raw.closed)
+    cubics = np.array(raw.pts, dtype=complex).reshape(-1, 4)
+    _elevate(cubics, np.array(raw.kinds, dtype=np.int8))
+    return cubics, np.array(raw.subs, dtype=np.intp), tuple(raw.closed)
 
 
 def cubics_from_path(path) -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
@@ -334,24 +241,211 @@ def _elevate_rows(cubics: np.ndarray, kinds: np.ndarray) -> None:
         cubics[quad, 2] = p3 + 2.0 / 3.0 * (q - p3)
 
 
+def cubics_from_table(table: PathTable) -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
+    """Convert a parsed path (:func:`~lsys_core.geometry.pathdata.parse_path`) to cubic arrays.
+
+    Moves and zero-length segments are dropped, arcs become cubics (a zero-radius arc a line), a
+    ``Z`` adds the line back to the subpath's start unless the subpath ends there (within rounding
+    noise, the last point is snapped to the start), and drawing after ``Z`` starts a new subpath.
+
+    Returns
+    -------
+    cubics : ndarray of complex, shape (k, 4)
+    subpaths : ndarray of int, shape (k,)
+        Subpath of each segment, numbered from 0 (subpaths without segments are dropped).
+    closed : tuple of bool
+        Whether each subpath ends with ``Z``.
+    """
+    op, pts = table.op, table.pts
+    n = op.size
+    if n == 0:
+        return _empty()
+    is_move = op == pd.MOVE
+    is_close = op == pd.CLOSE
+    after_close = np.zeros(n, dtype=bool)
+    after_close[1:] = is_close[:-1]
+    begins = is_move | (after_close & ~is_move)
+    sub = np.cumsum(begins) - 1
+    # A closing segment within rounding noise of its start: snap the previous end point instead.
+    cl = np.flatnonzero(is_close)
+    if cl.size:
+        p0, p3 = pts[cl, 0], pts[cl, 3]
+        tiny = (p0 != p3) & (np.abs(p0 - p3) <= _CLOSE_TOL * np.maximum(np.abs(p0), np.abs(p3)))
+        if tiny.any():
+            pts = pts.copy()
+            prev = cl - 1
+            snap = tiny & (prev >= 0) & ~is_move[np.maximum(prev, 0)] & ~is_close[np.maximum(prev, 0)]
+            pts[prev[snap], 3] = p3[snap]
+            pts[cl[tiny], 0] = pts[cl[tiny], 3]
+    kinds = np.full(n, _LINE, dtype=np.int8)
+    kinds[op == pd.QUAD] = _QUAD
+    kinds[op == pd.CUBIC] = _CUBIC
+    arc_rows = np.flatnonzero(op == pd.ARC)  # table.arc has one row per arc row, in order
+    rows = np.ones(n, dtype=bool)
+    rows[is_move] = False
+    degenerate = (pts[:, 0] == pts[:, 1]) & (pts[:, 1] == pts[:, 2]) & (pts[:, 2] == pts[:, 3])
+    rows &= ~degenerate
+    curved = np.zeros(0, dtype=np.intp)
+    if arc_rows.size:
+        rx, ry = np.abs(table.arc[:, 0]), np.abs(table.arc[:, 1])
+        sel = (rx > 0) & (ry > 0) & ~degenerate[arc_rows]
+        curved = arc_rows[sel]
+        rows[curved] = False
+    closed_sub = np.zeros(int(sub[-1]) + 1, dtype=bool)
+    closed_sub[sub[is_close]] = True
+    keep = np.flatnonzero(rows)
+    if curved.size == 0:
+        cub = pts[keep]
+        _elevate(cub, kinds[keep])
+        seg_sub = sub[keep]
+    else:
+        # Every kept row takes one slot, every curved arc as many as it has pieces, in row order.
+        setup = _arc_setup(pts[curved, 0], pts[curved, 3], table.arc[sel])
+        slots = rows.astype(np.intp)
+        slots[curved] = setup.pieces
+        offset = np.cumsum(slots) - slots
+        cub = np.empty((int(slots.sum()), 4), dtype=complex)
+        plain = pts[keep]
+        _elevate(plain, kinds[keep])
+        cub[offset[keep]] = plain
+        del plain
+        _fill_arcs(cub, offset[curved], setup, pts[curved, 0], pts[curved, 3])
+        seg_sub = np.repeat(sub, slots)
+    if cub.shape[0] == 0:
+        return _empty()
+    change = np.ones(seg_sub.size, dtype=bool)
+    change[1:] = seg_sub[1:] != seg_sub[:-1]  # subpath numbers never decrease: renumber the runs
+    subpaths = np.cumsum(change) - 1
+    return cub, subpaths, tuple(closed_sub[seg_sub[change]].tolist())
+
+
+#: Arcs converted at a time (bounds the temporary memory of the conversion).
+_ARC_CHUNK = 65536
+
+
+class _ArcSetup(NamedTuple):
+    """Centre parameterisation of arcs (SVG F.6.5) and the number of cubic pieces of each."""
+
+    cx: np.ndarray
+    cy: np.ndarray
+    rx: np.ndarray
+    ry: np.ndarray
+    cphi: np.ndarray
+    sphi: np.ndarray
+    theta1: np.ndarray
+    dtheta: np.ndarray
+    pieces: np.ndarray
+
+
+def _arc_setup(p0: np.ndarray, p3: np.ndarray, arc: np.ndarray) -> _ArcSetup:
+    """Convert endpoint to centre parameterisation (radii grown where too small), vectorised."""
+    rx, ry = np.abs(arc[:, 0]), np.abs(arc[:, 1])
+    phi = np.deg2rad(np.mod(arc[:, 2], 360.0))
+    large, sweep = arc[:, 3] != 0, arc[:, 4] != 0
+    cphi, sphi = np.cos(phi), np.sin(phi)
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        hx, hy = (p0.real - p3.real) / 2.0, (p0.imag - p3.imag) / 2.0
+        x1, y1 = cphi * hx + sphi * hy, -sphi * hx + cphi * hy
+        grow = np.sqrt(np.maximum((x1 / rx) ** 2 + (y1 / ry) ** 2, 1.0))
+        rx, ry = rx * grow, ry * grow
+        num = (rx * ry) ** 2 - (rx * y1) ** 2 - (ry * x1) ** 2
+        den = (rx * y1) ** 2 + (ry * x1) ** 2
+        coef = np.sqrt(np.maximum(num / den, 0.0))
+        coef = np.where(large == sweep, -coef, coef)
+        cxp, cyp = coef * rx * y1 / ry, -coef * ry * x1 / rx
+        cx = cphi * cxp - sphi * cyp + (p0.real + p3.real) / 2.0
+        cy = sphi * cxp + cphi * cyp + (p0.imag + p3.imag) / 2.0
+        theta1 = np.arctan2((y1 - cyp) / ry, (x1 - cxp) / rx)
+        theta2 = np.arctan2((-y1 - cyp) / ry, (-x1 - cxp) / rx)
+        dtheta = np.mod(theta2 - theta1, 2 * np.pi)
+        dtheta = np.where(~sweep & (dtheta > 0), dtheta - 2 * np.pi, dtheta)
+        dtheta = np.where(np.isfinite(dtheta), dtheta, 0.0)
+        count = np.maximum(np.ceil(np.abs(dtheta) / (np.pi / 4) - 1e-9), 1).astype(np.intp)
+    return _ArcSetup(cx, cy, rx, ry, cphi, sphi, theta1, dtheta, count)
+
+
+def _arc_pieces(a: _ArcSetup, p0: np.ndarray, p3: np.ndarray) -> np.ndarray:
+    """Return the cubic pieces of arcs (all pieces of the first arc, then of the next...)."""
+    count = a.pieces
+    # Boundary angles: count + 1 per arc; piece j of an arc runs from boundary j to j + 1.
+    nb = count + 1
+    own = np.repeat(np.arange(count.size), nb)
+    j = np.arange(own.size) - np.repeat(np.cumsum(nb) - nb, nb)
+    delta = a.dtheta / count
+    ang = a.theta1[own] + j * delta[own]
+    ca, sa = np.cos(ang), np.sin(ang)
+    rx, ry, c, s = a.rx[own], a.ry[own], a.cphi[own], a.sphi[own]
+    with np.errstate(invalid="ignore", over="ignore"):
+        ex, ey = rx * ca, ry * sa  # point on the axis-aligned ellipse
+        dx, dy = -rx * sa, ry * ca  # its tangent (per radian)
+        pt = (a.cx[own] + c * ex - s * ey) + 1j * (a.cy[own] + s * ex + c * ey)
+        tan = (c * dx - s * dy) + 1j * (s * dx + c * dy)
+        k = (4.0 / 3.0 * np.tan(delta / 4.0))[own]
+    is_start = np.ones(own.size, dtype=bool)
+    is_start[np.cumsum(nb) - 1] = False
+    b = np.flatnonzero(is_start)  # the boundary starting each piece
+    cubics = np.empty((b.size, 4), dtype=complex)
+    with np.errstate(invalid="ignore", over="ignore"):
+        cubics[:, 0] = pt[b]
+        cubics[:, 1] = pt[b] + k[b] * tan[b]
+        cubics[:, 2] = pt[b + 1] - k[b] * tan[b + 1]
+        cubics[:, 3] = pt[b + 1]
+    first = np.cumsum(count) - count
+    cubics[first, 0] = p0  # exact end points
+    cubics[first + count - 1, 3] = p3
+    return cubics
+
+
+def _slice_setup(a: _ArcSetup, sl: slice) -> _ArcSetup:
+    return _ArcSetup(*(f[sl] for f in a))
+
+
+def arc_cubics(p0: np.ndarray, p3: np.ndarray, arc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Approximate elliptical arcs (SVG endpoint parameterisation) by cubics, vectorised.
+
+    Parameters
+    ----------
+    p0, p3 : ndarray of complex, shape (n,)
+        Start and end points (distinct); radii must be non-zero.
+    arc : ndarray, shape (n, 5)
+        ``rx ry phi(degrees) large-arc-flag sweep-flag`` per arc.
+
+    Returns
+    -------
+    cubics : ndarray of complex, shape (m, 4)
+        Pieces of at most 45 degrees each (error below 5e-6 of the radius).
+    owner : ndarray of int, shape (m,)
+        The arc each piece belongs to (pieces of one arc are consecutive, in drawing order).
+    """
+    setup = _arc_setup(p0, p3, arc)
+    cubics = np.empty((int(setup.pieces.sum()), 4), dtype=complex)
+    _fill_arcs(cubics, np.cumsum(setup.pieces) - setup.pieces, setup, p0, p3)
+    return cubics, np.repeat(np.arange(p0.size), setup.pieces)
+
+
+def _fill_arcs(out: np.ndarray, slot: np.ndarray, setup: _ArcSetup, p0: np.ndarray, p3: np.ndarray) -> None:
+    """Write the pieces of every arc into ``out`` from row ``slot[i]`` on, a chunk of arcs at a time."""
+    for i in range(0, p0.size, _ARC_CHUNK):
+        sl = slice(i, i + _ARC_CHUNK)
+        part = _slice_setup(setup, sl)
+        pieces = _arc_pieces(part, p0[sl], p3[sl])
+        within = np.arange(pieces.shape[0]) - np.repeat(np.cumsum(part.pieces) - part.pieces, part.pieces)
+        out[np.repeat(slot[sl], part.pieces) + within] = pieces
+
+
 def cubics_from_d(d: str) -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
-    """Parse SVG path data into cubic arrays (see :func:`cubics_from_path`).
+    """Parse SVG path data into cubic arrays (see :func:`cubics_from_table`).
 
     Raises
     ------
     SvgError
-        If the path data cannot be parsed.
+        If the path data has an error anywhere (this reader is strict: it reads rule files).
     """
-    raw = raw_from_d(d)
-    if raw is not None:
-        return _to_arrays(raw)
-    from svgelements import Path
-
-    snippet = d if len(d) <= 40 else d[:37] + "..."
-    try:
-        return cubics_from_path(Path(d))
-    except SVGELEMENTS_ERRORS as exc:
-        raise SvgError(f"invalid path data {snippet!r}") from exc
+    table = parse_path(d)
+    if table.error is not None:
+        snippet = d if len(d) <= 40 else d[:37] + "..."
+        raise SvgError(f"invalid path data {snippet!r}: {table.error}")
+    return cubics_from_table(table)
 
 
 def _collinear_thirds(cubics: np.ndarray, tol: float) -> np.ndarray:

@@ -11,7 +11,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from lsys_core.errors import LimitError, SvgError
-from lsys_core.geometry.paths import MAX_COORD, SVGELEMENTS_ERRORS, RawPath, assemble, raw_from_segments
+from lsys_core.geometry.paths import (
+    MAX_COORD,
+    SVGELEMENTS_ERRORS,
+    ArrayPath,
+    _to_arrays,
+    assemble,
+    raw_from_segments,
+)
 from lsys_core.svg.model import Element
 from lsys_core.svg.prepare import SRC_ATTR, Prepared
 from lsys_core.svg.styles import own_opacity, style_of
@@ -71,7 +78,7 @@ def extract(prepared: Prepared, name: str) -> tuple[list[Element], Skips]:
             inverse = (inv.a, inv.b, inv.c, inv.d, inv.e, inv.f)
 
     skips = Skips()
-    raws: list[RawPath] = []
+    raws: list[ArrayPath] = []
     mats: list[tuple[float, ...]] = []
     styles: list[str] = []
     sources: list[str] = []
@@ -90,9 +97,9 @@ def extract(prepared: Prepared, name: str) -> tuple[list[Element], Skips]:
                 t = shape.transform
                 mat = (float(t.a), float(t.b), float(t.c), float(t.d), float(t.e), float(t.f))
             else:
-                raw = raw_from_segments(shape.segments(transformed=True))
+                raw = ArrayPath(*_to_arrays(raw_from_segments(shape.segments(transformed=True))))
                 mat = _IDENTITY
-            if not raw.pts:
+            if not raw.cubics.shape[0]:
                 skips.add(prepared.reasons.get(key, "degenerate (zero size)"))
                 continue
             style = style_of(shape, vp_scale, opacity)

@@ -13,7 +13,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 
 from lsys_core.errors import LimitError, SvgError
-from lsys_core.geometry.paths import SVGELEMENTS_ERRORS, RawPath, raw_from_d, raw_from_segments
+from lsys_core.geometry.paths import ArrayPath, path_from_d
 from lsys_core.svg.xmlsafe import (
     INTERNAL_SUBSET,
     SVG_NS,
@@ -68,7 +68,7 @@ class Prepared:
 
     data: bytes
     names: list[str]
-    paths: dict[str, RawPath]
+    paths: dict[str, ArrayPath]
     expected: int
     viewbox: tuple[float, float, float, float] | None
     size: tuple[str, str] | None
@@ -91,7 +91,7 @@ def prepare(source: str | bytes, max_elements: int, max_depth: int, name: str) -
         raise SvgError(f"not an SVG: {name}: the root element is <{root.tag}>, not <svg>")
 
     names: list[str] = []
-    paths: dict[str, RawPath] = {}
+    paths: dict[str, ArrayPath] = {}
     reasons: dict[str, str] = {}
     notes: list[str] = []
     transforms: list[tuple[str, str]] = []
@@ -162,30 +162,11 @@ def prepare(source: str | bytes, max_elements: int, max_depth: int, name: str) -
     return Prepared(ET.tostring(root), names, paths, expected, viewbox, size, reasons, notes, transforms)
 
 
-def _path_raw(d: str | None) -> tuple[RawPath, str | None]:
-    """Return the segments of path data and, if they may come out empty, why.
-
-    Data the fast parser declines (arcs, or errors) goes to svgelements, which draws
-    malformed data up to the first error as SVG asks; data it cannot read at all gives an
-    empty path with the reason ``malformed path data``.
-    """
-    if d is None:
-        return RawPath([], [], [], []), None
-    raw = raw_from_d(d)
-    if raw is not None:
-        return raw, None
-    from svgelements import Path
-
-    try:
-        path = Path(d)
-    except (*SVGELEMENTS_ERRORS, RecursionError):
-        return RawPath([], [], [], []), "malformed path data"
-    try:
-        raw = raw_from_segments(path)
-    except SVGELEMENTS_ERRORS:
-        return RawPath([], [], [], []), "invalid geometry"
-    has_arc = "a" in d or "A" in d
-    return raw, (None if has_arc else "malformed path data")
+def _path_raw(d: str | None) -> tuple[ArrayPath, str | None]:
+    """Return the segments of path data (drawn up to the first error, as SVG asks) and, if the
+    data has an error, the reason to give when nothing is drawn."""
+    path, error = path_from_d(d or "")
+    return path, (None if error is None or d is None else "malformed path data")
 
 
 def _clamp_opacity_text(text: str) -> str | None:

@@ -1,10 +1,12 @@
-"""Print SVG import and export times for 10,000 simple paths (not a test).
+"""Print SVG import and export times for 10,000 simple paths, and path-data reading of 10^6 commands (not a test).
 
 Run: ``PYTHONPATH=. .venv/bin/python tests/bench/bench_svg.py``
 """
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -63,5 +65,32 @@ def main(n: int = 10_000) -> None:
     print(f"export {k} instances: {t_export * 1000:.0f} ms")
 
 
+_PATH_DATA_CHILD = """
+import resource, sys, time
+from lsys_core.geometry.paths import cubics_from_d
+n, kind = int(sys.argv[1]), sys.argv[2]
+if kind == "L":
+    d = "M0 0 " + " ".join(f"L{i % 1000}.5 {i // 1000}" for i in range(n))
+else:
+    d = "M0 0 " + " ".join(f"A5 3 {i % 90} {i % 2} 1 {i % 1000}.5 {i // 1000}" for i in range(n))
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+t = time.perf_counter()
+cubics, _, _ = cubics_from_d(d)
+dt = time.perf_counter() - t
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+print(f"{dt:.2f} s, peak {peak / 1024:.0f} MiB (text and interpreter: {before / 1024:.0f} MiB), {len(cubics):,} cubics")
+"""
+
+
+def path_data(n: int = 1_000_000) -> None:
+    """Print the time and peak memory of reading path data of ``n`` line and ``n`` arc commands."""
+    for kind, label in (("L", "line"), ("A", "arc")):
+        out = subprocess.run(
+            [sys.executable, "-c", _PATH_DATA_CHILD, str(n), kind], capture_output=True, text=True, check=True
+        )
+        print(f"path data of {n:,} {label} commands: {out.stdout.strip()}")
+
+
 if __name__ == "__main__":
     main()
+    path_data()
