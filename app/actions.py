@@ -95,6 +95,13 @@ def create_actions(win: Any) -> None:
     win.act_randomize = _action(win, "&Randomize…", win.randomize_dialog, "Ctrl+R")
     win.act_unrandomize = _action(win, "Clear Randomization", lambda: doc.set_randomize(None))
     win.act_replace = _action(win, "Re&place Symbol…", win.replace_dialog, "Ctrl+Shift+R")
+    win.act_clean = _action(
+        win,
+        "&Clean Numbers",
+        doc.clean_numbers,
+        "Ctrl+Shift+C",
+        "Simplest values within tolerance: 0° for 0.44°",
+    )
     win.act_grow = _action(win, "&Grow", lambda: win.change_count(+1), "Ctrl+]", "Increase the axiom's m")
     win.act_shrink = _action(win, "S&hrink", lambda: win.change_count(-1), "Ctrl+[", "Decrease the axiom's m")
     win.act_fit = _action(win, "&Fit", canvas.fit, "Ctrl+0")
@@ -148,6 +155,7 @@ def create_menus(win: Any, docks: Iterable[Any]) -> None:
         win.act_randomize,
         win.act_unrandomize,
         win.act_replace,
+        win.act_clean,
         win.act_grow,
         win.act_shrink,
     ):

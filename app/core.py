@@ -15,6 +15,7 @@ from typing import Any
 __all__ = [
     "axiom_count",
     "default_settings",
+    "describe",
     "drawing_bounds",
     "export_png",
     "export_svg",
@@ -33,7 +34,10 @@ __all__ = [
     "set_params",
     "settings_from_dict",
     "shape_from_svg",
+    "snap",
+    "snap_params",
     "symmetrize",
+    "terminal_image",
     "write_atomic",
 ]
 
@@ -113,6 +117,59 @@ def set_params(grammar: Any, values: dict[str, float]) -> Any:
     from lsys_core.grammar import set_params as _set
 
     return _set(grammar, values)
+
+
+def describe(grammar: Any) -> tuple:
+    """Return the rules as designer's cards (``lsys_core.grammar.semantics.describe``)."""
+    from lsys_core.grammar.semantics import describe as _describe
+
+    return _describe(grammar)
+
+
+def snap(value: float, tolerance: float, kind: str, *, ring: int | None = None) -> float:
+    """Return the simplest value within ``tolerance`` (``lsys_core.grammar.snap.snap``)."""
+    from lsys_core.grammar.snap import snap as _snap
+
+    return _snap(value, tolerance, kind, ring=ring)
+
+
+def snap_params(grammar: Any) -> Any:
+    """Return ``grammar`` with clean numbers (``lsys_core.grammar.snap.snap_params``)."""
+    from lsys_core.grammar.snap import snap_params as _snap_params
+
+    return _snap_params(grammar)
+
+
+_THUMBNAILS: dict[tuple[str, str, int], Any] = {}
+
+
+def terminal_image(terminal: Any, size: int) -> Any:
+    """Return a ``size`` × ``size`` straight-RGBA array of one terminal's shape, fitted (cached)."""
+    key = (terminal.path, terminal.style, size)
+    image = _THUMBNAILS.get(key)
+    if image is None:
+        import dataclasses as _dc
+
+        import numpy as np
+
+        from lsys_core.derive.model import Drawing
+        from lsys_core.render.raster import default_view, render
+
+        one = Drawing(
+            (_dc.replace(terminal, name="T"),),
+            np.zeros(1, np.int32),
+            np.ones(1, complex),
+            np.zeros(1, complex),
+            np.zeros(1, np.int32),
+        )
+        x, y, w, h = default_view(one)
+        side = max(w, h)
+        view = (x - (side - w) / 2, y - (side - h) / 2, side, side)
+        image = render(one, size, size, view=view)
+        if len(_THUMBNAILS) > 512:
+            _THUMBNAILS.clear()
+        _THUMBNAILS[key] = image
+    return image
 
 
 def replace_terminal(grammar: Any, name: str, path_d: str, style: str) -> Any:

@@ -20,7 +20,6 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import os
-from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import QObject, Signal
@@ -30,6 +29,7 @@ from lsys_core.errors import LsysError
 
 from . import core
 from .commands import SettingsCommand, TextCommand
+from .doc_files import DocumentFiles
 from .inference_control import INFER_PRELOAD, InferenceControl, Purpose
 from .jobs import InferOutcome, InferRequest
 from .rules_model import RulesModel
@@ -37,7 +37,7 @@ from .rules_model import RulesModel
 __all__ = ["INFER_PRELOAD", "Document"]
 
 
-class Document(QObject):
+class Document(DocumentFiles, QObject):
     """The open document and the computations that keep it consistent.
 
     Signals
@@ -183,69 +183,6 @@ class Document(QObject):
         self.settings = settings
         self.settingsChanged.emit(settings)
 
-    # -- files ------------------------------------------------------------------------------------
-    def open_svg(self, path: str) -> None:
-        """Load an SVG and infer its grammar in the background (replaces the document when done)."""
-        request = InferRequest(None, self.settings, svg_path=str(path))
-        self.inference.submit(Purpose("open", path=str(path)), request)
-
-    def open_lsys(self, path: str) -> None:
-        """Open an .lsys rules file; the input scene is cleared.
-
-        Raises
-        ------
-        LsysError
-            If the file cannot be read (a parse error only marks the text).
-        """
-        text = core.read_text(path)
-        self.inference.cancel()
-        self._replace(None, None, str(path), text)
-        self.pathChanged.emit()
-
-    def save(self, path: str | None = None) -> None:
-        """Write the rules text to ``path`` (default: the current path) atomically."""
-        target = str(path or self.path or "")
-        if not target:
-            raise LsysError("no file name to save to")
-        core.write_atomic(target, self.text.encode("utf-8"))
-        self.path = target
-        self.undo_stack.setClean()
-        self.pathChanged.emit()
-
-    def restore(self, state: dict[str, Any]) -> None:
-        """Restore a recovered session (rules text, settings, file names)."""
-        self.inference.cancel()
-        self.undo_stack.clear()
-        self.apply_settings(core.settings_from_dict(state.get("settings") or {}))
-        self.path = state.get("path")
-        scene_path = state.get("scene_path")
-        self.scene, self.scene_path, self.result = None, None, None
-        self.sceneChanged.emit()
-        self.undo_stack.push(TextCommand(self, "Restore unsaved work", self.text, state.get("text", "")))
-        self.pathChanged.emit()
-        if scene_path and Path(scene_path).is_file():  # load the input in the background, no inference
-            request = InferRequest(None, self.settings, svg_path=scene_path, load_only=True)
-            self.inference.submit(Purpose("reload", path=scene_path), request)
-
-    def snapshot(self) -> dict[str, Any]:
-        """Return the state autosave writes (see :meth:`restore`)."""
-        return {
-            "text": self.text,
-            "settings": dataclasses.asdict(self.settings),
-            "path": self.path,
-            "scene_path": self.scene_path,
-        }
-
-    def _replace(self, scene: Any, scene_path: str | None, path: str | None, text: str, **known: Any) -> None:
-        """Make a new document of ``text`` (``known``: its grammar and drawing); no undo history."""
-        self.scene, self.scene_path, self.path = scene, scene_path, path
-        self._restore_settings()
-        self.rules.clear()
-        self.undo_stack.clear()
-        self.sceneChanged.emit()
-        self.rules.apply_text(text, **known)
-        self.undo_stack.setClean()
-
     # -- edits (each pushes one undoable command) ---------------------------------------------------
     def begin_gesture(self) -> None:
         """Start a gesture (slider or handle drag): its edits merge into one undo step, drawn as drafts."""
@@ -345,6 +282,16 @@ class Document(QObject):
         label = "Randomize" if randomize is not None else "Clear randomization"
         self.apply_grammar(dataclasses.replace(grammar, randomize=randomize), label)
 
+    def clean_numbers(self) -> None:
+        """Snap every number of the rules to its simplest value within tolerance: one step, or a message."""
+        grammar = self.editable_grammar()
+        if grammar is None:
+            return
+        if not self.apply_grammar(core.snap_params(grammar), "Clean numbers"):
+            self.message.emit(
+                "Clean numbers: nothing changed (the numbers are already as simple as they can be)."
+            )
+
     def preview_randomize(self, randomize: Any) -> None:
         """Draw with ``randomize`` without changing the rules (None ends the preview)."""
         self.rules.set_preview_randomize(randomize)
@@ -393,7 +340,9 @@ class Document(QObject):
             self.sceneChanged.emit()
         elif kind == "open":
             self.result = out.result
-            self._replace(out.scene, purpose.path, None, out.text, grammar=out.grammar, drawing=out.drawing)
+            self.replace_document(
+                out.scene, purpose.path, None, out.text, grammar=out.grammar, drawing=out.drawing
+            )
             self.pathChanged.emit()
             warnings = getattr(out.scene, "warnings", ())
             if warnings:  # one line: the message bar shows only the latest message

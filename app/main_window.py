@@ -36,6 +36,7 @@ from .params_panel import ParamsPanel
 from .recent_files import RecentFiles
 from .recovery import Recovery
 from .rules_panel import RulesPanel
+from .rules_view import RulesView
 
 __all__ = ["MainWindow"]
 
@@ -86,6 +87,7 @@ class MainWindow(QMainWindow):
 
         self.rules_panel = RulesPanel(self)
         self.params_panel = ParamsPanel(self)
+        self.rules_view = RulesView(self)
         self.inference_panel = InferencePanel(self)
         self.rules_dock = self._dock(
             "Rules", "rules", self.rules_panel, Qt.DockWidgetArea.RightDockWidgetArea
@@ -93,6 +95,11 @@ class MainWindow(QMainWindow):
         self.params_dock = self._dock(
             "Parameters", "params", self.params_panel, Qt.DockWidgetArea.RightDockWidgetArea
         )
+        self.cards_dock = self._dock(
+            "Rule Cards", "cards", self.rules_view, Qt.DockWidgetArea.RightDockWidgetArea
+        )
+        self.tabifyDockWidget(self.params_dock, self.cards_dock)
+        self.cards_dock.raise_()
         self.inference_dock = self._dock(
             "Inference", "inference", self.inference_panel, Qt.DockWidgetArea.LeftDockWidgetArea
         )
@@ -110,7 +117,7 @@ class MainWindow(QMainWindow):
         self._panels_timer.setInterval(0)
         self._panels_timer.timeout.connect(self._update_panels)
         create_actions(self)
-        create_menus(self, (self.rules_dock, self.params_dock, self.inference_dock))
+        create_menus(self, (self.rules_dock, self.cards_dock, self.params_dock, self.inference_dock))
         self._connect()
         self.inference_panel.set_settings(self.doc.settings)
         self._update_actions()
@@ -161,6 +168,10 @@ class MainWindow(QMainWindow):
         self.rules_panel.editor.undoRequested.connect(d.undo_stack.undo)
         self.rules_panel.editor.redoRequested.connect(d.undo_stack.redo)
         self.params_panel.paramEdited.connect(d.set_param)
+        self.rules_view.controlEdited.connect(self._on_control_edited)
+        self.rules_view.dragStarted.connect(d.begin_gesture)
+        self.rules_view.dragFinished.connect(d.end_gesture)
+        self.rules_view.ruleSelected.connect(self.select_rule)
         self.params_panel.dragStarted.connect(d.begin_gesture)
         self.params_panel.dragFinished.connect(d.end_gesture)
         self.inference_panel.settingsEdited.connect(d.set_settings)
@@ -197,13 +208,35 @@ class MainWindow(QMainWindow):
             return
         try:
             self.params_panel.set_params(core.list_params(grammar))
+            self.rules_view.set_cards(grammar, core.describe(grammar))
         except LsysError as exc:
             self.show_message(str(exc))
 
+    def _on_control_edited(self, owner: str, label: str, value: float) -> None:
+        """A semantic control moved: set every parameter it writes, as one edit."""
+        control = self.rules_view.control(owner, label)
+        if control is None:
+            return
+        name = "the start" if owner == "axiom" else owner
+        self.doc.set_params(control.values(value), f"Change {label} of {name}", f"control:{owner}:{label}")
+
+    def select_rule(self, name: str | None) -> None:
+        """Select rule ``name`` (``"axiom"``: the start; None: nothing) in every view."""
+        grammar = self.doc.grammar
+        index = None
+        if name and grammar is not None:
+            index = (
+                -1
+                if name == "axiom"
+                else next((i for i, r in enumerate(grammar.rules) if r.name == name), None)
+            )
+        self.rules_panel.highlight_rule(name)
+        self.rules_view.select(name)
+        self.canvas.set_highlight_rule(index)
+
     def _on_scene_changed(self) -> None:
         self.canvas.set_overlay_svg(self.doc.scene_path)
-        self.canvas.set_highlight_rule(None)
-        self.rules_panel.highlight_rule(None)
+        self.select_rule(None)
         if self.doc.scene_path:
             self.recent.add(self.doc.scene_path)
             self.canvas.fit_on_next_drawing()
@@ -220,13 +253,11 @@ class MainWindow(QMainWindow):
     def _on_element_clicked(self, index: int) -> None:
         drawing, grammar = self.doc.drawing, self.doc.grammar
         if drawing is None or grammar is None or index < 0:
-            self.rules_panel.highlight_rule(None)
-            self.canvas.set_highlight_rule(None)
+            self.select_rule(None)
             return
         rule = int(drawing.rule[index])
         name = "axiom" if rule < 0 or rule >= len(grammar.rules) else grammar.rules[rule].name
-        self.rules_panel.highlight_rule(name)
-        self.canvas.set_highlight_rule(rule)
+        self.select_rule(name)
         self.statusBar().showMessage(f"element {index} drawn by {name}", 5000)
 
     def _update_actions(self, *_args: Any) -> None:
@@ -237,6 +268,7 @@ class MainWindow(QMainWindow):
         for act in (
             self.act_randomize,
             self.act_replace,
+            self.act_clean,
             self.act_grow,
             self.act_shrink,
             self.act_export_svg,

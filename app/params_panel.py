@@ -23,7 +23,9 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-__all__ = ["OPEN_ROWS", "ROWS_PER_PAGE", "ParamRow", "ParamsPanel", "slider_range"]
+from . import core
+
+__all__ = ["OPEN_ROWS", "ROWS_PER_PAGE", "ParamRow", "ParamsPanel", "scroll_column", "slider_range"]
 
 SLIDER_STEPS = 1000
 #: Rows a section shows at once (more on request).
@@ -61,6 +63,44 @@ def slider_range(kind: str, value: float) -> tuple[float, float]:
     return -span, span
 
 
+def scroll_column(
+    owner: QWidget, empty_text: str, *, spacing: int
+) -> tuple[QScrollArea, QWidget, QVBoxLayout, QLabel]:
+    """Fill ``owner`` with a scrolled column of widgets and a note shown while it is empty.
+
+    Returns the scroll area (hidden), the column's widget, its layout (ending in a stretch:
+    insert before it) and the note.
+    """
+    scroll = QScrollArea(owner)
+    scroll.setWidgetResizable(True)
+    content = QWidget()
+    column = QVBoxLayout(content)
+    column.setContentsMargins(4, 4, 4, 4)
+    column.setSpacing(spacing)
+    column.addStretch(1)
+    scroll.setWidget(content)
+    empty = QLabel(empty_text, owner)
+    empty.setWordWrap(True)
+    empty.setAlignment(Qt.AlignmentFlag.AlignCenter)
+    layout = QVBoxLayout(owner)
+    layout.setContentsMargins(0, 0, 0, 0)
+    layout.addWidget(empty)
+    layout.addWidget(scroll, 1)
+    scroll.hide()
+    return scroll, content, column, empty
+
+
+class CleanSpinBox(QDoubleSpinBox):
+    """A spin box that shows ``46`` and ``18.5``, not ``46.000`` and ``18.500``."""
+
+    def textFromValue(self, value: float) -> str:
+        """Return ``value`` at the box's decimals without trailing zeros."""
+        text = f"{value:.{self.decimals()}f}"
+        if "." in text:
+            text = text.rstrip("0").rstrip(".")
+        return "0" if text in ("-0", "") else text
+
+
 class ParamRow(QWidget):
     """One parameter: a slider over :func:`slider_range` and an exact spin box.
 
@@ -81,7 +121,7 @@ class ParamRow(QWidget):
         self.slider = QSlider(Qt.Orientation.Horizontal, self)
         self.slider.setRange(0, SLIDER_STEPS)
         self.slider.setMinimumWidth(120)
-        self.spin = QDoubleSpinBox(self)
+        self.spin = CleanSpinBox(self)
         self.spin.setRange(-_SPIN_LIMIT, _SPIN_LIMIT)
         self.spin.setKeyboardTracking(False)
         self.spin.setMinimumWidth(90)
@@ -143,8 +183,14 @@ class ParamRow(QWidget):
         return round(min(1.0, max(0.0, t)) * SLIDER_STEPS)
 
     def _from_slider(self, pos: int) -> float:
+        """Return the value at slider position ``pos``: the simplest within half a slider step."""
         v = self.lo + (self.hi - self.lo) * pos / SLIDER_STEPS
-        return float(round(v)) if self.integer else v
+        if self.integer:
+            return float(round(v))
+        half = (self.hi - self.lo) / SLIDER_STEPS / 2
+        if self.kind == "scale":  # snap takes a relative tolerance for scales
+            half = half / abs(v) if v else 0.0
+        return core.snap(v, half, self.kind)
 
     def _on_slider(self, pos: int) -> None:
         value = self._from_slider(pos)
@@ -282,22 +328,9 @@ class ParamsPanel(QWidget):
         self._values: dict[str, Any] = {}
         self._sections: list[_Section] = []
         self._kinds: list[tuple[str, str]] = []
-        self._scroll = QScrollArea(self)
-        self._scroll.setWidgetResizable(True)
-        self._content = QWidget()
-        self._column = QVBoxLayout(self._content)
-        self._column.setContentsMargins(4, 4, 4, 4)
-        self._column.setSpacing(0)
-        self._column.addStretch(1)
-        self._scroll.setWidget(self._content)
-        self._empty = QLabel("Open an SVG or .lsys file to edit its parameters.", self)
-        self._empty.setWordWrap(True)
-        self._empty.setAlignment(Qt.AlignmentFlag.AlignCenter)
-        layout = QVBoxLayout(self)
-        layout.setContentsMargins(0, 0, 0, 0)
-        layout.addWidget(self._empty)
-        layout.addWidget(self._scroll, 1)
-        self._scroll.hide()
+        self._scroll, self._content, self._column, self._empty = scroll_column(
+            self, "Open an SVG or .lsys file to edit its parameters.", spacing=0
+        )
 
     def current(self, param: Any) -> Any:
         """Return ``param`` with the newest value known for its key."""

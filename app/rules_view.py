@@ -1,0 +1,247 @@
+"""The rules view: one card per rule, in a designer's words, beside the rules text.
+
+Each card shows the rule's kind in words ("ring of 8", "row of 12, 46 apart"), thumbnails of
+the terminals it draws, the rules it uses, and one control per *semantic* parameter (count,
+step distance and direction, turn and scale per step).  The cards come from
+``lsys_core.grammar.semantics.describe``; a control writes every place its value occurs, so the
+``+(α) … +(-α)`` pair of a step moves as one.  Editing a control forwards
+``(rule, control, value)``; the window turns it into one document edit, and the text follows.
+
+Like the parameters panel, cards fold: only open cards have control rows, and cards and rows
+are reused from one grammar to the next.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtGui import QImage, QPixmap
+from PySide6.QtWidgets import (
+    QFrame,
+    QHBoxLayout,
+    QLabel,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from lsys_core.grammar import Param
+
+from . import core
+from .params_panel import ParamRow, scroll_column
+
+__all__ = ["OPEN_CONTROLS", "RulesView", "thumbnail"]
+
+#: Cards open on a new grammar until about this many controls are shown.
+OPEN_CONTROLS = 30
+THUMB = 36
+_SEP = "\x1f"
+
+
+def thumbnail(terminal: Any, size: int, dpr: float = 1.0) -> QPixmap:
+    """Return a pixmap of ``terminal``'s shape fitted in ``size`` logical pixels."""
+    px = max(8, round(size * dpr))
+    pixels = core.terminal_image(terminal, px)
+    image = QImage(pixels.data, px, px, pixels.strides[0], QImage.Format.Format_RGBA8888).copy()
+    pixmap = QPixmap.fromImage(image)
+    pixmap.setDevicePixelRatio(dpr)
+    return pixmap
+
+
+class _Card(QFrame):
+    """One rule: a header that folds, thumbnails, and its controls when open."""
+
+    def __init__(self, view: RulesView) -> None:
+        super().__init__(view._content)
+        self.view = view
+        self.card: Any = None
+        self.setObjectName("card")
+        self.setFrameShape(QFrame.Shape.StyledPanel)
+        self.fold = QToolButton(self)
+        self.fold.setCheckable(True)
+        self.fold.setAutoRaise(True)
+        self.fold.toggled.connect(lambda _on: self._refresh())
+        self.title = QLabel(self)
+        self.title.setTextFormat(Qt.TextFormat.RichText)
+        self.title.setWordWrap(True)
+        head = QHBoxLayout()
+        head.setContentsMargins(0, 0, 0, 0)
+        head.addWidget(self.fold)
+        head.addWidget(self.title, 1)
+        self.thumbs = QHBoxLayout()
+        self.thumbs.setContentsMargins(22, 0, 0, 0)
+        self.thumbs.setSpacing(4)
+        self.thumb_labels: list[QLabel] = []
+        self.uses = QLabel(self)
+        self.uses.setStyleSheet("color: palette(mid);")
+        self.thumbs.addWidget(self.uses)
+        self.thumbs.addStretch(1)
+        self.body = QWidget(self)
+        self.rows_layout = QVBoxLayout(self.body)
+        self.rows_layout.setContentsMargins(22, 0, 0, 0)
+        self.rows_layout.setSpacing(2)
+        self.lines: list[tuple[QWidget, QLabel, ParamRow]] = []
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(4, 4, 4, 4)
+        layout.setSpacing(2)
+        layout.addLayout(head)
+        layout.addLayout(self.thumbs)
+        layout.addWidget(self.body)
+
+    def configure(self, card: Any, open_: bool, terminals: dict[str, Any]) -> None:
+        """Show ``card``; ``open_`` unfolds its controls."""
+        self.card = card
+        name = "Start (axiom)" if card.owner == "axiom" else card.owner
+        summary = card.summary.split(": ", 1)[-1] if card.owner == "axiom" else card.summary
+        self.title.setText(f"<b>{name}</b> — {summary}")
+        self.fold.blockSignals(True)
+        self.fold.setChecked(open_)
+        self.fold.blockSignals(False)
+        self._show_thumbs([terminals[t] for t in card.terminals if t in terminals])
+        self.uses.setText(("uses " + ", ".join(card.calls)) if card.calls else "")
+        self.uses.setVisible(bool(card.calls))
+        self._refresh()
+
+    def _show_thumbs(self, terms: list[Any]) -> None:
+        dpr = float(self.devicePixelRatioF())
+        for i, t in enumerate(terms):
+            if i == len(self.thumb_labels):
+                label = QLabel(self)
+                label.setFixedSize(THUMB, THUMB)
+                label.setStyleSheet("background: white; border: 1px solid palette(mid);")
+                self.thumbs.insertWidget(i, label)
+                self.thumb_labels.append(label)
+            label = self.thumb_labels[i]
+            label.setPixmap(thumbnail(t, THUMB - 2, dpr))
+            label.setToolTip(f"terminal {t.name}")
+            label.show()
+        for label in self.thumb_labels[len(terms) :]:
+            label.hide()
+
+    def update_values(self, card: Any) -> None:
+        """Show the values of ``card`` (same controls as shown) without rebuilding."""
+        self.card = card
+        self.title.setText(self.title.text().split(" — ", 1)[0] + " — " + card.summary.split(": ", 1)[-1])
+        for (line, _label, row), ctl in zip(self.lines, card.controls, strict=False):
+            if line.isVisible() and not row.slider.isSliderDown() and not row.spin.hasFocus():
+                row.set_value(ctl.value)
+
+    def _refresh(self) -> None:
+        open_ = self.fold.isChecked() and self.card is not None
+        controls = self.card.controls if open_ else ()
+        self.fold.setArrowType(Qt.ArrowType.DownArrow if open_ else Qt.ArrowType.RightArrow)
+        self.fold.setEnabled(bool(self.card is not None and self.card.controls))
+        for i, ctl in enumerate(controls):
+            param = Param(self.card.owner + _SEP + ctl.label, ctl.label, ctl.value, ctl.kind)
+            if i == len(self.lines):
+                line = QWidget(self.body)
+                label = QLabel(line)
+                label.setMinimumWidth(110)
+                row = ParamRow(param, line)
+                row.valueEdited.connect(self.view._on_row_edited)
+                row.dragStarted.connect(self.view.dragStarted)
+                row.dragFinished.connect(self.view.dragFinished)
+                lay = QHBoxLayout(line)
+                lay.setContentsMargins(0, 0, 0, 0)
+                lay.addWidget(label)
+                lay.addWidget(row, 1)
+                self.rows_layout.addWidget(line)
+                self.lines.append((line, label, row))
+            line, label, row = self.lines[i]
+            row.configure(param)
+            label.setText(ctl.label + (f" ({ctl.unit})" if ctl.unit else ""))
+            label.setToolTip("writes " + ", ".join(w.key for w in ctl.writes))
+            line.show()
+        for line, _label, _row in self.lines[len(controls) :]:
+            line.hide()
+        self.body.setVisible(bool(controls))
+
+    def set_selected(self, selected: bool) -> None:
+        """Frame the card when its rule is selected."""
+        self.setStyleSheet("QFrame#card { border: 2px solid #f9a825; }" if selected else "")
+
+    def mousePressEvent(self, event) -> None:
+        """A click selects the rule."""
+        if self.card is not None:
+            self.view.ruleSelected.emit(self.card.owner)
+        super().mousePressEvent(event)
+
+
+class RulesView(QWidget):
+    """The dock content: a card per rule.
+
+    Signals
+    -------
+    controlEdited(rule, label, value)
+        A control of rule ``rule`` (``axiom`` for the start) was moved to ``value``.
+    ruleSelected(rule)
+        A card was clicked.
+    dragStarted(), dragFinished()
+    """
+
+    controlEdited = Signal(str, str, float)
+    ruleSelected = Signal(str)
+    dragStarted = Signal()
+    dragFinished = Signal()
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.cards: dict[str, Any] = {}
+        self._widgets: list[_Card] = []
+        self._shape: list[tuple[str, tuple[str, ...]]] = []
+        self._selected: str | None = None
+        self._scroll, self._content, self._column, self._empty = scroll_column(
+            self, "Open an SVG or .lsys file to see its rules.", spacing=4
+        )
+
+    def widget_of(self, owner: str) -> _Card | None:
+        """Return the card widget of rule ``owner`` (None if it has none)."""
+        return next((w for w in self._widgets if w.isVisible() and w.card and w.card.owner == owner), None)
+
+    def control(self, owner: str, label: str) -> Any:
+        """Return the current :class:`~lsys_core.grammar.semantics.Control` of a rule, or None."""
+        card = self.cards.get(owner)
+        return next((c for c in card.controls if c.label == label), None) if card is not None else None
+
+    def set_cards(self, grammar: Any, cards: tuple) -> None:
+        """Show the cards of ``grammar`` (values only, if the rules and controls are the same)."""
+        self.cards = {c.owner: c for c in cards}
+        shape = [(c.owner, tuple(k.label for k in c.controls)) for c in cards]
+        visible = [w for w in self._widgets if w.isVisible()]
+        if shape == self._shape:
+            for widget, card in zip(visible, cards, strict=True):
+                widget.update_values(card)
+            return
+        self._shape = shape
+        terminals = {t.name: t for t in grammar.terminals}
+        budget = OPEN_CONTROLS
+        for i, card in enumerate(cards):
+            if i == len(self._widgets):
+                widget = _Card(self)
+                self._column.insertWidget(i, widget)
+                self._widgets.append(widget)
+            widget = self._widgets[i]
+            open_ = budget > 0 and bool(card.controls)
+            widget.configure(card, open_, terminals)
+            widget.set_selected(card.owner == self._selected)
+            widget.show()
+            if open_:
+                budget -= len(card.controls)
+        for widget in self._widgets[len(cards) :]:
+            widget.hide()
+        self._scroll.setVisible(bool(cards))
+        self._empty.setVisible(not cards)
+
+    def select(self, owner: str | None) -> None:
+        """Frame the card of rule ``owner`` and scroll to it (None: no selection)."""
+        self._selected = owner
+        for widget in self._widgets:
+            widget.set_selected(widget.card is not None and widget.card.owner == owner and widget.isVisible())
+        widget = self.widget_of(owner) if owner else None
+        if widget is not None:
+            self._scroll.ensureWidgetVisible(widget, 0, 8)
+
+    def _on_row_edited(self, key: str, value: float) -> None:
+        owner, label = key.split(_SEP, 1)
+        self.controlEdited.emit(owner, label, value)

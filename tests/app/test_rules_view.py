@@ -1,0 +1,102 @@
+"""The rules view: cards in words, semantic controls that keep coupled values coupled, clean numbers."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+from PySide6.QtCore import QPointF, Qt
+
+GRID = """lsys 1
+terminal A "M 0 0 L 8 0 L 8 8 Z" style "fill:#789"
+axiom: +(45) f(100) +(-45) Q(3)
+P(m): m > 0 -> A f(20) P(m-1)
+P(m): m == 0 -> A
+Q(m): m > 0 -> [ P(11) ] +(90) f(30) +(-90) Q(m-1)
+Q(m): m == 0 -> P(11)
+"""
+
+
+@pytest.fixture
+def grid(window, tmp_path, wait_idle):
+    path = tmp_path / "grid.lsys"
+    path.write_text(GRID, encoding="utf-8")
+    window.open_path(str(path))
+    wait_idle(window)
+    return window
+
+
+def _control_row(window, owner: str, label: str):
+    card = window.rules_view.widget_of(owner)
+    for line, text, row in card.lines:
+        if line.isVisible() and text.text().split(" (")[0] == label:
+            return row
+    raise AssertionError(f"no control {label} on {owner}")
+
+
+def test_cards_say_what_each_rule_draws(grid):
+    cards = grid.rules_view.cards
+    assert cards["P"].summary == "row of 12, 20 apart"
+    assert cards["Q"].summary.startswith("row of 4 × P, 30 apart")
+    widget = grid.rules_view.widget_of("P")
+    assert widget.thumb_labels[0].isVisible() and not widget.thumb_labels[0].pixmap().isNull()
+    assert "row of 12" in widget.title.text()
+
+
+def test_direction_moves_the_coupled_pair_as_one_step_and_the_text_follows(grid, wait_idle):
+    doc = grid.doc
+    row = _control_row(grid, "axiom", "to Q: direction")
+    row.spin.setValue(30)
+    wait_idle(grid)
+    assert "axiom: +(30) f(100) +(-30) Q(3)" in doc.text
+    assert grid.rules_panel.text() == doc.text
+    assert doc.undo_stack.count() == 1
+    doc.undo_stack.undo()
+    wait_idle(grid)
+    assert "axiom: +(45) f(100) +(-45) Q(3)" in doc.text
+    assert _control_row(grid, "axiom", "to Q: direction").value() == pytest.approx(45)
+
+
+def test_count_writes_every_call_and_a_drag_is_one_step_with_clean_numbers(grid, wait_idle, qtbot):
+    doc = grid.doc
+    count = _control_row(grid, "P", "count")
+    count.spin.setValue(8)
+    wait_idle(grid)
+    assert doc.text.count("P(7)") == 2 and "P(11)" not in doc.text
+    assert len(doc.drawing) == 8 * 4
+    distance = _control_row(grid, "P", "step distance")
+    distance.slider.setSliderDown(True)
+    for pos in (distance.slider.value() + 7, distance.slider.value() + 13, distance.slider.value() + 29):
+        distance.slider.setValue(pos)
+    distance.slider.setSliderDown(False)
+    wait_idle(grid)
+    assert doc.undo_stack.count() == 2  # the count, then the whole drag
+    step = re.search(r"A f\(([^)]*)\) P\(m-1\)", doc.text).group(1)
+    assert len(step.split(".")[-1]) <= 3 and step != "20"  # a clean number, not 20.579999999999998
+
+
+def test_clicks_select_the_same_rule_in_canvas_cards_and_text(grid, qtbot, wait_idle):
+    card = grid.rules_view.widget_of("Q")
+    qtbot.mouseClick(card, Qt.MouseButton.LeftButton)
+    assert grid.rules_view._selected == "Q" and grid.canvas._highlight_rule == 1
+    drawing = grid.doc.drawing
+    i = int((drawing.rule == 0).nonzero()[0][0])  # an instance drawn by P
+    x, y = grid.canvas.view.to_widget(drawing.b[i].real + 4, drawing.b[i].imag + 2)
+    grid.canvas.elementClicked.emit(grid.canvas.pick(QPointF(x, y)))
+    assert grid.rules_view._selected == "P" and grid.canvas._highlight_rule == 0
+    assert grid.rules_panel.editor._rule_lines  # the text highlights P's lines too
+
+
+def test_clean_numbers_is_one_step_or_a_message(window, tmp_path, wait_idle):
+    path = tmp_path / "noisy.lsys"
+    path.write_text(GRID.replace("+(45) f(100) +(-45)", "+(0.44) f(100.0000001) +(-0.44)"), encoding="utf-8")
+    window.open_path(str(path))
+    wait_idle(window)
+    doc = window.doc
+    messages = []
+    doc.message.connect(messages.append)
+    window.act_clean.trigger()
+    wait_idle(window)
+    assert "axiom: +(0) f(100) +(0) Q(3)" in doc.text and doc.undo_stack.count() == 1
+    window.act_clean.trigger()
+    assert doc.undo_stack.count() == 1 and "nothing changed" in messages[-1]
