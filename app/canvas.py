@@ -29,7 +29,7 @@ from PySide6.QtWidgets import QSizePolicy, QWidget
 from . import core
 from .workers import LatestRunner
 
-__all__ = ["Canvas", "Frame", "RenderRequest", "View", "recolor"]
+__all__ = ["Canvas", "Frame", "RenderRequest", "View", "group_color", "legend", "recolor", "rule_color"]
 
 SETTLE_MS = 120  # quiet time after pan/zoom before rendering at full quality
 BACKGROUND = (255, 255, 255, 255)
@@ -165,6 +165,27 @@ def _style_with_color(style: str, color: str) -> str:
     return ";".join(f"{k}:{v}" for k, v in decls.items())
 
 
+def group_color(terminal: int) -> str:
+    """Return the colour of terminal index ``terminal`` (a similarity group) in colour-by-group mode."""
+    return PALETTE[terminal % len(PALETTE)]
+
+
+def rule_color(rule: int) -> str:
+    """Return the colour of rule index ``rule`` (-1: the axiom) in colour-by-rule mode."""
+    return PALETTE[(rule + 1) % len(PALETTE)]
+
+
+def legend(grammar: Any, mode: str) -> list[tuple[str, str]]:
+    """Return ``(colour, what)`` for every colour the canvas uses in ``mode`` (none: empty)."""
+    if grammar is None or mode == "none":
+        return []
+    if mode == "group":
+        return [(group_color(i), f"terminal {t.name}") for i, t in enumerate(grammar.terminals)]
+    return [(rule_color(-1), "Start (axiom)")] + [
+        (rule_color(i), r.name) for i, r in enumerate(grammar.rules)
+    ]
+
+
 def recolor(drawing: Any, mode: str) -> Any:
     """Return ``drawing`` with terminal styles coloured by similarity group or by rule.
 
@@ -177,15 +198,13 @@ def recolor(drawing: Any, mode: str) -> Any:
     terms = drawing.terminals
     if mode == "group":
         styled = tuple(
-            dataclasses.replace(t, style=_style_with_color(t.style, PALETTE[i % len(PALETTE)]))
+            dataclasses.replace(t, style=_style_with_color(t.style, group_color(i)))
             for i, t in enumerate(terms)
         )
         return dataclasses.replace(drawing, terminals=styled)
     pairs, inverse = np.unique(np.stack([drawing.symbol, drawing.rule], axis=1), axis=0, return_inverse=True)
     styled = tuple(
-        dataclasses.replace(
-            terms[s], style=_style_with_color(terms[s].style, PALETTE[(r + 1) % len(PALETTE)])
-        )
+        dataclasses.replace(terms[s], style=_style_with_color(terms[s].style, rule_color(r)))
         for s, r in pairs.tolist()
     )
     return dataclasses.replace(drawing, terminals=styled, symbol=inverse.reshape(-1).astype(np.int32))
@@ -232,6 +251,7 @@ class Canvas(QWidget):
         self.last_frame_seconds = 0.0
         self._highlight: np.ndarray | None = None
         self._highlight_rule: int | None = None
+        self._highlight_terminal: int | None = None
         self.runner = LatestRunner(
             render_frame, name="lsys-render", prepare=self._assign_surface, parent=self
         )
@@ -261,15 +281,30 @@ class Canvas(QWidget):
             self.fit(render=False)
         self.request_render()
 
-    def set_highlight_rule(self, rule: int | None) -> None:
-        """Draw the instances emitted by rule index ``rule`` (-1: the axiom) in the highlight colour."""
+    def set_highlight_rule(self, rule: Any) -> None:
+        """Draw the instances emitted by rule index ``rule`` (-1: the axiom; a list: several) highlighted."""
         self._highlight_rule = rule
+        self._highlight_terminal = None
+        self._update_highlight()
+        self.request_render()
+
+    def set_highlight_terminal(self, symbol: int | None) -> None:
+        """Draw the instances of terminal index ``symbol`` in the highlight colour (None: none)."""
+        self._highlight_terminal = symbol
+        self._highlight_rule = None
         self._update_highlight()
         self.request_render()
 
     def _update_highlight(self) -> None:
-        d, r = self.drawing, self._highlight_rule
-        self._highlight = None if d is None or r is None or len(d) == 0 else np.asarray(d.rule) == r
+        d, r, t = self.drawing, self._highlight_rule, self._highlight_terminal
+        if d is None or len(d) == 0 or (r is None and t is None):
+            self._highlight = None
+        else:
+            rules = np.asarray(d.rule)
+            if r is None:
+                self._highlight = np.asarray(d.symbol) == t
+            else:
+                self._highlight = np.isin(rules, r) if isinstance(r, (list, tuple, set)) else rules == r
 
     def fit_on_next_drawing(self) -> None:
         """Fit the view to the next drawing shown (a new file)."""

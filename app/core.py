@@ -30,6 +30,8 @@ __all__ = [
     "read_text",
     "replace_terminal",
     "replace_with_terminal",
+    "restyle_terminal",
+    "rules_under",
     "set_param",
     "set_params",
     "settings_from_dict",
@@ -126,6 +128,13 @@ def describe(grammar: Any) -> tuple:
     return _describe(grammar)
 
 
+def rules_under(grammar: Any, name: str) -> set[str]:
+    """Return ``name`` and the rules it uses (``lsys_core.grammar.semantics.rules_under``)."""
+    from lsys_core.grammar.semantics import rules_under as _under
+
+    return _under(grammar, name)
+
+
 def snap(value: float, tolerance: float, kind: str, *, ring: int | None = None) -> float:
     """Return the simplest value within ``tolerance`` (``lsys_core.grammar.snap.snap``)."""
     from lsys_core.grammar.snap import snap as _snap
@@ -170,6 +179,27 @@ def terminal_image(terminal: Any, size: int) -> Any:
             _THUMBNAILS.clear()
         _THUMBNAILS[key] = image
     return image
+
+
+def restyle_terminal(grammar: Any, name: str, changes: dict[str, str | None]) -> Any:
+    """Return ``grammar`` with CSS declarations of terminal ``name`` set (None removes one)."""
+    import dataclasses as _dc
+
+    from lsys_core.errors import GrammarError
+    from lsys_core.render.paths import parse_style
+
+    term = grammar.terminal(name)
+    if term is None:
+        raise GrammarError(f"no terminal named {name}")
+    decls = parse_style(term.style)
+    for key, value in changes.items():
+        if value is None:
+            decls.pop(key, None)
+        else:
+            decls[key] = value
+    style = ";".join(f"{k}:{v}" for k, v in decls.items())
+    terminals = tuple(_dc.replace(t, style=style) if t.name == name else t for t in grammar.terminals)
+    return _dc.replace(grammar, terminals=terminals)
 
 
 def replace_terminal(grammar: Any, name: str, path_d: str, style: str) -> Any:

@@ -9,7 +9,8 @@ import random
 from dataclasses import dataclass
 from typing import Any
 
-from PySide6.QtCore import Signal
+from PySide6.QtCore import QSize, Signal
+from PySide6.QtGui import QIcon
 from PySide6.QtWidgets import (
     QComboBox,
     QDialog,
@@ -30,6 +31,20 @@ from lsys_core.grammar.model import Randomize
 __all__ = ["RandomizeDialog", "ReplaceChoice", "ReplaceDialog"]
 
 SEED_MAX = 2**31 - 1
+THUMB = 32
+
+
+def _icon(path: str, style: str) -> QIcon:
+    """Return a thumbnail icon of a shape (empty if it cannot be drawn)."""
+    from lsys_core.errors import LsysError
+    from lsys_core.grammar.model import Terminal
+
+    from .rules_view import thumbnail
+
+    try:
+        return QIcon(thumbnail(Terminal("T", path, style), THUMB))
+    except (LsysError, ValueError):
+        return QIcon()
 
 
 class RandomizeDialog(QDialog):
@@ -154,7 +169,13 @@ class ReplaceDialog(QDialog):
     """
 
     def __init__(
-        self, grammar: Any, input_terminals=(), load_shape=None, parent: QWidget | None = None
+        self,
+        grammar: Any,
+        input_terminals=(),
+        load_shape=None,
+        parent: QWidget | None = None,
+        *,
+        target: str | None = None,
     ) -> None:
         super().__init__(parent)
         self.setWindowTitle("Replace symbol")
@@ -166,11 +187,13 @@ class ReplaceDialog(QDialog):
         for i, t in enumerate(input_terminals):
             self._sources.append((f"input element group {i + 1}", "", t.path, t.style))
         self.target = QComboBox(self)
+        self.target.setIconSize(QSize(THUMB, THUMB))
         for t in grammar.terminals:
-            self.target.addItem(f"{t.name} (terminal)", ("terminal", t.name))
+            self.target.addItem(_icon(t.path, t.style), f"{t.name} (terminal)", ("terminal", t.name))
         for r in grammar.rules:
             self.target.addItem(f"{r.name} (non-terminal)", ("nonterminal", r.name))
         self.source = QComboBox(self)
+        self.source.setIconSize(QSize(THUMB, THUMB))
         self.load_button = QPushButton("From SVG file…", self)
         self.load_button.clicked.connect(self._load_file)
         self.error = QLabel(self)
@@ -193,17 +216,21 @@ class ReplaceDialog(QDialog):
         layout.addWidget(self.error)
         layout.addWidget(buttons)
         self.target.currentIndexChanged.connect(self._fill_sources)
+        if target is not None:
+            for i in range(self.target.count()):
+                if self.target.itemData(i) == ("terminal", target):
+                    self.target.setCurrentIndex(i)
         self._fill_sources()
 
     def _fill_sources(self, _index: int = 0) -> None:
         kind, name = self.target.currentData() or ("terminal", "")
         self.source.clear()
-        for i, (label, term, _path, _style) in enumerate(self._sources):
+        for i, (label, term, path, style) in enumerate(self._sources):
             if kind == "nonterminal" and not term:
                 continue  # a non-terminal is replaced by a terminal of the grammar
             if kind == "terminal" and term == name:
                 continue
-            self.source.addItem(label, i)
+            self.source.addItem(_icon(path, style), label, i)
         self.load_button.setEnabled(kind == "terminal" and self._load_shape is not None)
         self._ok.setEnabled(self.source.count() > 0)
 

@@ -7,18 +7,14 @@ canvas (and in the status bar), never as a crash or a modal box that stops the e
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import QSettings, Qt, QTimer
 from PySide6.QtGui import QCloseEvent
 from PySide6.QtWidgets import (
     QDockWidget,
-    QFileDialog,
     QLabel,
     QMainWindow,
-    QMessageBox,
     QVBoxLayout,
     QWidget,
 )
@@ -27,7 +23,7 @@ from lsys_core.errors import LsysError
 
 from . import core
 from .actions import create_actions, create_menus, redo_keys, undo_keys
-from .canvas import Canvas
+from .canvas import Canvas, legend
 from .dialogs import RandomizeDialog, ReplaceDialog
 from .document import Document
 from .inference_panel import InferencePanel
@@ -37,13 +33,13 @@ from .recent_files import RecentFiles
 from .recovery import Recovery
 from .rules_panel import RulesPanel
 from .rules_view import RulesView
+from .structure_panel import StructurePanel
+from .window_files import WindowFiles
 
 __all__ = ["MainWindow"]
 
-FILE_FILTER = "SVG or L-system (*.svg *.lsys);;SVG files (*.svg);;L-system rules (*.lsys);;All files (*)"
 
-
-class MainWindow(QMainWindow):
+class MainWindow(WindowFiles, QMainWindow):
     """The editor window.
 
     Parameters
@@ -89,6 +85,7 @@ class MainWindow(QMainWindow):
         self.params_panel = ParamsPanel(self)
         self.rules_view = RulesView(self)
         self.inference_panel = InferencePanel(self)
+        self.structure_panel = StructurePanel(self)
         self.rules_dock = self._dock(
             "Rules", "rules", self.rules_panel, Qt.DockWidgetArea.RightDockWidgetArea
         )
@@ -103,8 +100,13 @@ class MainWindow(QMainWindow):
         self.inference_dock = self._dock(
             "Inference", "inference", self.inference_panel, Qt.DockWidgetArea.LeftDockWidgetArea
         )
+        self.structure_dock = self._dock(
+            "Structure", "structure", self.structure_panel, Qt.DockWidgetArea.LeftDockWidgetArea
+        )
         self.resizeDocks([self.rules_dock, self.params_dock], [460, 380], Qt.Orientation.Vertical)
         self.resizeDocks([self.rules_dock, self.inference_dock], [520, 320], Qt.Orientation.Horizontal)
+        self.tabifyDockWidget(self.inference_dock, self.structure_dock)
+        self.inference_dock.raise_()
 
         self._status_labels = {
             k: QLabel(self) for k in ("elements", "symbols", "rules", "compression", "time")
@@ -117,7 +119,10 @@ class MainWindow(QMainWindow):
         self._panels_timer.setInterval(0)
         self._panels_timer.timeout.connect(self._update_panels)
         create_actions(self)
-        create_menus(self, (self.rules_dock, self.cards_dock, self.params_dock, self.inference_dock))
+        create_menus(
+            self,
+            (self.rules_dock, self.cards_dock, self.params_dock, self.inference_dock, self.structure_dock),
+        )
         self._connect()
         self.inference_panel.set_settings(self.doc.settings)
         self._update_actions()
@@ -172,6 +177,11 @@ class MainWindow(QMainWindow):
         self.rules_view.dragStarted.connect(d.begin_gesture)
         self.rules_view.dragFinished.connect(d.end_gesture)
         self.rules_view.ruleSelected.connect(self.select_rule)
+        self.structure_panel.ruleSelected.connect(self.select_rule)
+        self.structure_panel.terminalSelected.connect(self.highlight_terminal)
+        self.structure_panel.replaceRequested.connect(self.replace_dialog)
+        self.structure_panel.styleEdited.connect(self.restyle_terminal)
+        d.drawingChanged.connect(self.structure_panel.set_drawing)
         self.params_panel.dragStarted.connect(d.begin_gesture)
         self.params_panel.dragFinished.connect(d.end_gesture)
         self.inference_panel.settingsEdited.connect(d.set_settings)
@@ -185,6 +195,27 @@ class MainWindow(QMainWindow):
         """Colour the canvas by ``"group"``, ``"rule"`` or not at all (``"none"``)."""
         self.canvas.set_color_mode(mode)
         self.act_colors[mode].setChecked(True)
+        self.structure_panel.set_legend(legend(self.doc.grammar, mode))
+
+    def restyle_terminal(self, name: str, changes: dict) -> None:
+        """Set fill, stroke or opacity of terminal ``name``: one undo step."""
+        grammar = self.doc.editable_grammar()
+        if grammar is None:
+            return
+        try:
+            new = core.restyle_terminal(grammar, name, changes)
+        except LsysError as exc:
+            self.show_message(str(exc))
+            return
+        what = ", ".join(f"{k} {v}" for k, v in changes.items())
+        self.doc.apply_grammar(new, f"Set {what} of {name}", merge_key=self.doc.merge_key(f"style:{name}"))
+
+    def highlight_terminal(self, name: str) -> None:
+        """Show the instances of terminal ``name`` on the canvas (``""``: none)."""
+        grammar = self.doc.grammar
+        names = [t.name for t in grammar.terminals] if grammar is not None else []
+        self.select_rule(None)
+        self.canvas.set_highlight_terminal(names.index(name) if name in names else None)
 
     # -- messages and state -------------------------------------------------------------------------
     def show_message(self, text: str) -> None:
@@ -208,7 +239,10 @@ class MainWindow(QMainWindow):
             return
         try:
             self.params_panel.set_params(core.list_params(grammar))
-            self.rules_view.set_cards(grammar, core.describe(grammar))
+            cards = core.describe(grammar)
+            self.rules_view.set_cards(grammar, cards)
+            self.structure_panel.set_content(grammar, cards, self.doc.drawing)
+            self.structure_panel.set_legend(legend(grammar, self.canvas.color_mode))
         except LsysError as exc:
             self.show_message(str(exc))
 
@@ -223,15 +257,15 @@ class MainWindow(QMainWindow):
     def select_rule(self, name: str | None) -> None:
         """Select rule ``name`` (``"axiom"``: the start; None: nothing) in every view."""
         grammar = self.doc.grammar
-        index = None
-        if name and grammar is not None:
-            index = (
-                -1
-                if name == "axiom"
-                else next((i for i, r in enumerate(grammar.rules) if r.name == name), None)
+        index: Any = None
+        if name and grammar is not None:  # the rule's instances and those of the rules it uses
+            under = core.rules_under(grammar, name)
+            index = [i for i, r in enumerate(grammar.rules) if r.name in under] + (
+                [-1] if name == "axiom" else []
             )
         self.rules_panel.highlight_rule(name)
         self.rules_view.select(name)
+        self.structure_panel.select_rule(name)
         self.canvas.set_highlight_rule(index)
 
     def _on_scene_changed(self) -> None:
@@ -310,106 +344,6 @@ class MainWindow(QMainWindow):
             and not self.rules_panel.editor.highlighter.pending
         )
 
-    # -- files ----------------------------------------------------------------------------------------
-    def open_path(self, path: str) -> None:
-        """Open an SVG (inferring its rules) or an .lsys file; errors become messages."""
-        if not self.maybe_save():
-            return
-        path = str(path)
-        if not os.path.isfile(path):
-            self.show_message(f"Cannot open {path}: no such file")
-            return
-        if path.lower().endswith(".lsys"):
-            try:
-                self.doc.open_lsys(path)
-            except LsysError as exc:
-                self.show_message(f"Could not open {os.path.basename(path)}: {exc}")
-                return
-            self.recent.add(path)
-            self.canvas.fit_on_next_drawing()
-            self.message_bar.hide()
-        else:
-            self.statusBar().showMessage(f"Opening {os.path.basename(path)}…")
-            self.doc.open_svg(path)
-
-    def open_dialog(self) -> None:
-        """Ask for a file and open it."""
-        path, _ = QFileDialog.getOpenFileName(self, "Open", self._last_dir(), FILE_FILTER)
-        if path:
-            self.open_path(path)
-
-    def save(self) -> bool:
-        """Save the rules to the current .lsys file (asks for a name if there is none)."""
-        if not self.doc.path:
-            return self.save_as()
-        return self._save_to(self.doc.path)
-
-    def save_as(self) -> bool:
-        """Ask for a file name and save the rules there."""
-        suggestion = self.doc.path or (
-            str(Path(self.doc.scene_path).with_suffix(".lsys"))
-            if self.doc.scene_path
-            else os.path.join(self._last_dir(), "untitled.lsys")
-        )
-        path, _ = QFileDialog.getSaveFileName(self, "Save rules", suggestion, "L-system rules (*.lsys)")
-        return bool(path) and self._save_to(path)
-
-    def _save_to(self, path: str) -> bool:
-        try:
-            self.doc.save(path)
-        except LsysError as exc:
-            self.show_message(f"Could not save: {exc}")
-            return False
-        self.recent.add(path)
-        self.statusBar().showMessage(f"Saved {path}", 5000)
-        return True
-
-    def export_svg(self, path: str) -> bool:
-        """Write the current drawing as SVG; errors become messages."""
-        return self._export(core.export_svg, path)
-
-    def export_png(self, path: str) -> bool:
-        """Render the current drawing into a PNG file; errors become messages."""
-        return self._export(core.export_png, path)
-
-    def _export(self, fn, path: str) -> bool:
-        if self.doc.drawing is None:
-            self.show_message("Nothing to export yet.")
-            return False
-        try:
-            fn(self.doc.drawing, path)
-        except LsysError as exc:
-            self.show_message(f"Could not export: {exc}")
-            return False
-        self.statusBar().showMessage(f"Exported {path}", 5000)
-        return True
-
-    def export_svg_dialog(self) -> None:
-        """Ask for a file name and export SVG."""
-        path, _ = QFileDialog.getSaveFileName(
-            self, "Export SVG", self._export_name(".svg"), "SVG files (*.svg)"
-        )
-        if path:
-            self.export_svg(path)
-
-    def export_png_dialog(self) -> None:
-        """Ask for a file name and export PNG."""
-        path, _ = QFileDialog.getSaveFileName(
-            self, "Export PNG", self._export_name(".png"), "PNG images (*.png)"
-        )
-        if path:
-            self.export_png(path)
-
-    def _export_name(self, suffix: str) -> str:
-        base = self.doc.path or self.doc.scene_path
-        if base:
-            return str(Path(base).with_name(Path(base).stem + "-derived" + suffix))
-        return os.path.join(self._last_dir(), "derived" + suffix)
-
-    def _last_dir(self) -> str:
-        recent = self.recent.files()
-        return os.path.dirname(recent[0]) if recent else os.getcwd()
-
     # -- actions ---------------------------------------------------------------------------------------
     def randomize_dialog(self) -> None:
         """Show the randomize dialog: Apply and Re-roll preview, OK is one undo step, Cancel none."""
@@ -422,13 +356,15 @@ class MainWindow(QMainWindow):
         else:
             self.doc.preview_randomize(None)
 
-    def replace_dialog(self) -> None:
-        """Show the replace-symbol dialog and apply the choice."""
+    def replace_dialog(self, target: str | None = None) -> None:
+        """Show the replace-symbol dialog (for terminal ``target`` if given) and apply the choice."""
         grammar = self.doc.editable_grammar()
         if grammar is None:
             return
         inst = getattr(self.doc.result, "instancing", None)
-        dialog = ReplaceDialog(grammar, getattr(inst, "terminals", ()), core.shape_from_svg, self)
+        dialog = ReplaceDialog(
+            grammar, getattr(inst, "terminals", ()), core.shape_from_svg, self, target=target or None
+        )
         if dialog.exec():
             choice = dialog.choice()
             if choice is not None:
@@ -469,44 +405,7 @@ class MainWindow(QMainWindow):
         except LsysError as exc:
             self.show_message(str(exc))
 
-    # -- drag and drop, close ---------------------------------------------------------------------------
-    def dragEnterEvent(self, event) -> None:
-        """Accept dragged .svg and .lsys files."""
-        if any(
-            u.isLocalFile() and u.toLocalFile().lower().endswith((".svg", ".lsys"))
-            for u in event.mimeData().urls()
-        ):
-            event.acceptProposedAction()
-
-    def dropEvent(self, event) -> None:
-        """Open the first dropped .svg or .lsys file."""
-        for url in event.mimeData().urls():
-            path = url.toLocalFile()
-            if url.isLocalFile() and path.lower().endswith((".svg", ".lsys")):
-                event.acceptProposedAction()
-                self.open_path(path)
-                return
-
-    def ask_save_changes(self) -> QMessageBox.StandardButton:
-        """Ask whether to save unsaved changes (Save, Discard or Cancel)."""
-        B = QMessageBox.StandardButton
-        return QMessageBox.question(
-            self,
-            "Unsaved changes",
-            f"Save the changes to {self.doc.display_name()}?",
-            B.Save | B.Discard | B.Cancel,
-            B.Save,
-        )
-
-    def maybe_save(self) -> bool:
-        """Offer to save unsaved changes; return False if the user cancelled."""
-        if not self.doc.modified:
-            return True
-        answer = self.ask_save_changes()
-        if answer == QMessageBox.StandardButton.Save:
-            return self.save()
-        return answer == QMessageBox.StandardButton.Discard
-
+    # -- close ---------------------------------------------------------------------------------------------
     def closeEvent(self, event: QCloseEvent) -> None:
         """Offer to save, keep the layout, stop the workers and remove the recovery file."""
         if not self.maybe_save():

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 from lsys_core.grammar.model import COND_EQ0, Grammar, Module, Rule, Symbol, Turtle
 
-__all__ = ["Card", "Control", "Write", "describe"]
+__all__ = ["Card", "Control", "Write", "describe", "rules_under"]
 
 _FLAT_SCALE = 1e-3  # |scale - 1| below this: no growth or shrinking
 _STRAIGHT = 0.5  # degrees of turn per step below which a sequence is straight
@@ -417,3 +417,19 @@ def describe(g: Grammar) -> tuple[Card, ...]:
         tuple(_merge(axiom_controls)),
     )
     return (start, *(_card(g, r, sites.get(r.name, [])) for r in g.rules))
+
+
+def rules_under(g: Grammar, name: str) -> set[str]:
+    """Return the rules whose instances belong to ``name``'s structure: itself and every rule it uses.
+
+    ``name`` is a rule name or ``axiom`` (then every rule reachable from the start).
+    """
+    uses = {r.name: {m.name for c in r.cases for m in c.body if isinstance(m, Symbol)} for r in g.rules}
+    todo = [m.name for m in g.axiom if isinstance(m, Symbol)] if name == "axiom" else [name]
+    seen: set[str] = set()
+    while todo:
+        n = todo.pop()
+        if n in uses and n not in seen:
+            seen.add(n)
+            todo.extend(uses[n])
+    return seen

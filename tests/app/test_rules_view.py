@@ -78,12 +78,15 @@ def test_count_writes_every_call_and_a_drag_is_one_step_with_clean_numbers(grid,
 def test_clicks_select_the_same_rule_in_canvas_cards_and_text(grid, qtbot, wait_idle):
     card = grid.rules_view.widget_of("Q")
     qtbot.mouseClick(card, Qt.MouseButton.LeftButton)
-    assert grid.rules_view._selected == "Q" and grid.canvas._highlight_rule == 1
+    assert grid.rules_view._selected == "Q" and sorted(grid.canvas._highlight_rule) == [
+        0,
+        1,
+    ]  # Q and the P it uses
     drawing = grid.doc.drawing
     i = int((drawing.rule == 0).nonzero()[0][0])  # an instance drawn by P
     x, y = grid.canvas.view.to_widget(drawing.b[i].real + 4, drawing.b[i].imag + 2)
     grid.canvas.elementClicked.emit(grid.canvas.pick(QPointF(x, y)))
-    assert grid.rules_view._selected == "P" and grid.canvas._highlight_rule == 0
+    assert grid.rules_view._selected == "P" and grid.canvas._highlight_rule == [0]
     assert grid.rules_panel.editor._rule_lines  # the text highlights P's lines too
 
 
