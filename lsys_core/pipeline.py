@@ -16,6 +16,7 @@ from lsys_core.cancel import CancelToken, Progress, check, report
 from lsys_core.derive.derivation import derive
 from lsys_core.errors import InferenceError
 from lsys_core.grammar.model import Grammar
+from lsys_core.hierarchy.cache import LevelCache
 from lsys_core.hierarchy.mdl import Precision, grammar_bits
 from lsys_core.hierarchy.pivots import estimate_pivots, recenter
 from lsys_core.hierarchy.postprocess import simplify
@@ -27,7 +28,15 @@ from lsys_core.settings import SETTINGS, setting
 from lsys_core.settings import check as check_setting
 from lsys_core.svg.model import Scene
 
-__all__ = ["InferenceResult", "InferenceSettings", "infer", "symmetrize"]
+__all__ = [
+    "Analysis",
+    "InferenceResult",
+    "InferenceSettings",
+    "analyse",
+    "infer",
+    "rules_from_analysis",
+    "symmetrize",
+]
 
 #: Bandwidth factor used by :func:`symmetrize` (the paper's "relaxed sensitivity").
 RELAXED = 12.0
@@ -172,47 +181,76 @@ def reproduction_error(inst: Instancing, sizes: np.ndarray, drawing) -> float:
     return worst
 
 
-def infer(
+@dataclass(frozen=True, eq=False)
+class Analysis:
+    """What inference computes once per scene, whatever the importance weights (§4, §5.3).
+
+    Similarity detection and inverse instancing (with the fidelity split, unwrapped symmetric
+    rotations and pivots), the shape similarity of the terminals, the precision of the
+    description, and a cache of every hierarchy level's transformation spaces, clustering and
+    candidates.  :func:`rules_from_analysis` turns it into rules for any weights: only
+    importance, rule generation, post-processing and derivation run again.  Made by
+    :func:`analyse`; keep it in the process that made it.
+
+    Attributes
+    ----------
+    scene : Scene
+        The analysed scene.
+    settings : InferenceSettings
+        The settings it was made with (its weights are only defaults).
+    instancing : Instancing
+        Terminals and poses after the fidelity split, unwrapping and pivots.
+    sizes, center, radius : ndarray
+        Reach of every terminal's shape from its origin; bounding circle of every element.
+    precision : Precision
+        The tolerance the description is written at.
+    shape_similarity : ndarray
+        φ of every pair of terminals.
+    levels : LevelCache
+        Candidates of the hierarchy levels met so far (filled by rule generation).
+    stages : dict
+        Seconds spent in the analysis stages.
+    """
+
+    scene: Scene
+    settings: InferenceSettings
+    instancing: Instancing
+    sizes: np.ndarray
+    center: np.ndarray
+    radius: np.ndarray
+    precision: Precision
+    shape_similarity: np.ndarray
+    levels: LevelCache
+    stages: dict[str, float]
+
+
+def analyse(
     scene: Scene,
     settings: InferenceSettings = InferenceSettings(),
     *,
+    previous: Analysis | None = None,
     cancel: CancelToken | None = None,
     progress: Progress | None = None,
-    symmetrizing: bool = False,
-) -> InferenceResult:
-    """Infer a compact L-system that regenerates ``scene`` (paper §4–§5).
+) -> Analysis:
+    """Analyse ``scene`` once for any number of rule generations (see :class:`Analysis`).
 
-    Parameters
-    ----------
-    scene : Scene
-        The imported SVG.
-    settings : InferenceSettings
-        Weights, similarity threshold and clustering tolerance.
-    cancel : CancelToken, optional
-        Checked between stages and levels; raises :class:`~lsys_core.errors.Cancelled`.
-    progress : callable, optional
-        ``progress(stage, fraction)`` for the stages ``similarity`` and ``rules``.
-    symmetrizing : bool
-        Used by :func:`symmetrize`: relaxed bandwidths, larger accepted deviation.
-
-    Notes
-    -----
-    Rules are written only when they shorten the description of the drawing (minimum
-    description length, :mod:`lsys_core.hierarchy.mdl`) and derive their elements within the
-    tolerance.  If the rules found at the user's clustering bandwidth leave elements
-    unexplained by any repetition, the clustering is relaxed (×3 … ×15) and the shortest
-    grammar (in bits) that stays within the tolerance is kept.
-
-    Returns
-    -------
-    InferenceResult
+    With ``previous`` (an analysis of the same scene object), only what ``settings`` change
+    is computed again: a new similarity threshold redoes everything; a new number of
+    neighbours starts an empty level cache; new weights or a new tolerance reuse all of it
+    (the level cache is keyed by the bandwidths).
     """
     from lsys_core.instancing.similarity import detect_similarity
 
     settings = settings.validated()
     if not scene.elements:
         raise InferenceError("the scene has no drawable elements")
-    t_all = time.perf_counter()
+    if (
+        previous is not None
+        and previous.scene is scene
+        and previous.settings.similarity == settings.similarity
+    ):
+        same = previous.settings.neighbours == settings.neighbours
+        return replace(previous, settings=settings, levels=previous.levels if same else LevelCache())
     stages: dict[str, float] = {}
     t = time.perf_counter()
     inst = detect_similarity(scene, threshold=settings.similarity, cancel=cancel, progress=progress)
@@ -239,10 +277,47 @@ def infer(
     inst = recenter(inst, offsets)
     sizes = sizes + np.abs(offsets)  # how far each shape reaches from its (moved) origin
     stages["pivots"] = time.perf_counter() - t
-    weights = Weights(settings.wn, settings.wh, settings.wphi, settings.wl)
+    shape_sim = _shape_similarity(inst, cancel)
+    return Analysis(scene, settings, inst, sizes, center, radius, prec, shape_sim, LevelCache(), stages)
+
+
+def rules_from_analysis(
+    analysis: Analysis,
+    weights: Weights | None = None,
+    *,
+    tolerance: float | None = None,
+    symmetrizing: bool = False,
+    cancel: CancelToken | None = None,
+    progress: Progress | None = None,
+) -> InferenceResult:
+    """Generate rules from an :class:`Analysis` with the importance ``weights`` (§5.4–§5.7).
+
+    Gives what :func:`infer` gives with those weights; levels whose candidates the analysis
+    already holds are not clustered again.
+
+    Parameters
+    ----------
+    analysis : Analysis
+        From :func:`analyse`.
+    weights : Weights, optional
+        Importance weights (default: those of ``analysis.settings``).
+    tolerance : float, optional
+        Factor on the clustering bandwidths (default: ``analysis.settings.tolerance``).
+    symmetrizing : bool
+        Relaxed acceptance of :func:`symmetrize`.
+    """
+    settings = analysis.settings
+    if weights is None:
+        weights = Weights(settings.wn, settings.wh, settings.wphi, settings.wl)
+    if tolerance is not None:
+        settings = replace(settings, tolerance=tolerance).validated()
+    replace(settings, wn=weights.wn, wh=weights.wh, wphi=weights.wphi, wl=weights.wl).validated()
+    scene, inst, sizes, prec = analysis.scene, analysis.instancing, analysis.sizes, analysis.precision
+    t_all = time.perf_counter()
+    stages = dict(analysis.stages)
+    diag = _diagonal(analysis.center, analysis.radius)
     if symmetrizing:
         prec = prec.relaxed(max(prec.eps, SYMMETRIZE_ERROR * diag))
-    shape_sim = _shape_similarity(inst, cancel)
     best: tuple[Grammar, Hierarchy, float, float] | None = None
     for factor in _factors(settings, symmetrizing, len(scene.elements)):
         check(cancel)
@@ -252,17 +327,18 @@ def infer(
             inst.group,
             inst.a,
             inst.b,
-            center,
-            radius,
+            analysis.center,
+            analysis.radius,
             weights=weights,
             tol=Tolerance().scaled(factor),
-            similarity=shape_sim,
+            similarity=analysis.shape_similarity,
             precision=prec,
             symmetry=inst.symmetry,
             neighbours=settings.neighbours,
             cancel=cancel,
             progress=progress,
             timer=stages,
+            cache=analysis.levels,
         )
         t = time.perf_counter()
         grammar = simplify(Grammar(inst.terminals, tuple(hier.rules), hier.axiom, scene.viewbox, scene.size))
@@ -281,6 +357,50 @@ def infer(
     stages["reproduction_error"] = error / diag
     report(progress, "done", 1.0)
     return InferenceResult(grammar, inst, stages, time.perf_counter() - t_all, tuple(hier.log))
+
+
+def infer(
+    scene: Scene,
+    settings: InferenceSettings = InferenceSettings(),
+    *,
+    cancel: CancelToken | None = None,
+    progress: Progress | None = None,
+    symmetrizing: bool = False,
+) -> InferenceResult:
+    """Infer a compact L-system that regenerates ``scene`` (paper §4–§5).
+
+    :func:`analyse` then :func:`rules_from_analysis`; keep the :class:`Analysis` to try other
+    weights cheaply.
+
+    Parameters
+    ----------
+    scene : Scene
+        The imported SVG.
+    settings : InferenceSettings
+        Weights, similarity threshold and clustering tolerance.
+    cancel : CancelToken, optional
+        Checked between stages and levels; raises :class:`~lsys_core.errors.Cancelled`.
+    progress : callable, optional
+        ``progress(stage, fraction)`` for the stages ``similarity`` and ``rules``.
+    symmetrizing : bool
+        Used by :func:`symmetrize`: relaxed bandwidths, larger accepted deviation.
+
+    Notes
+    -----
+    Rules are written only when they shorten the description of the drawing (minimum
+    description length, :mod:`lsys_core.hierarchy.mdl`) and derive their elements within the
+    tolerance.  If the rules found at the user's clustering bandwidth leave elements
+    unexplained by any repetition, the clustering is relaxed (×3 … ×15) and the shortest
+    grammar (in bits) that stays within the tolerance is kept.
+
+    Returns
+    -------
+    InferenceResult
+    """
+    t_all = time.perf_counter()
+    analysis = analyse(scene, settings, cancel=cancel, progress=progress)
+    result = rules_from_analysis(analysis, symmetrizing=symmetrizing, cancel=cancel, progress=progress)
+    return replace(result, seconds=time.perf_counter() - t_all)
 
 
 def symmetrize(

@@ -38,6 +38,9 @@ def _weights(p: argparse.ArgumentParser) -> None:
         g.add_argument(
             f"--{s.name}", type=float, help=f"{s.help}, in {s.range_text()} (default {s.default:g})"
         )
+    g.add_argument(
+        "--jobs", metavar="N", help="worker threads (default: $LSYS_JOBS, else the cores available)"
+    )
 
 
 def _png(p: argparse.ArgumentParser) -> None:

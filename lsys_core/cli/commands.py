@@ -109,8 +109,12 @@ def _load_rules(path: str):
 
 
 def _settings(args: argparse.Namespace):
+    from lsys_core.parallel import jobs, set_jobs
     from lsys_core.pipeline import InferenceSettings
     from lsys_core.settings import SETTINGS
+
+    set_jobs(getattr(args, "jobs", None))
+    jobs()  # a bad LSYS_JOBS is reported before any work
 
     kw = {s.name: getattr(args, s.name) for s in SETTINGS}
     return InferenceSettings(**{k: v for k, v in kw.items() if v is not None}).validated()

@@ -26,11 +26,12 @@ from lsys_core.hierarchy.candidates import (
     proximity,
     space_key,
 )
-from lsys_core.hierarchy.chains import chain_pairs, chains
+from lsys_core.hierarchy.chains import link_clusters
 from lsys_core.hierarchy.clustering import group_indices, mean_shift
 from lsys_core.hierarchy.gain import Ledger, cluster_bounds
 from lsys_core.hierarchy.linear import linear_candidates
 from lsys_core.hierarchy.spaces import PairSpace
+from lsys_core.parallel import submit
 
 __all__ = ["find_candidates"]
 
@@ -71,40 +72,38 @@ def find_candidates(
             key * 1e7,
         ]
     )
+    prox = proximity(ps, sym.size, radius)
+    # The linear sequences (clusters D) need nothing from the clusters C: found beside them.
+    linear = submit(linear_candidates, ctx, sym, ps, prox, size, key, ledger)
     labels, _ = mean_shift(emb)
     if ledger is not None:
         hopeless = cluster_bounds(ledger, labels, ps.src, ps.dst) <= 0.0
         labels = np.where((labels >= 0) & ~hopeless[np.maximum(labels, 0)], labels, -1)
-    prox = proximity(ps, sym.size, radius)
     n_nodes = sym.size
     out: list[Candidate] = []
     found: list[ConstantCluster] = []
     pending: list[tuple[int, ConstantCluster]] = []
-    for idx in group_indices(labels):
-        if idx.size < 2:
-            continue  # a single pair repeats nothing
+    clusters = [idx for idx in group_indices(labels) if idx.size >= 2]  # a single pair repeats nothing
+    costs = [np.linalg.norm(emb[idx, :5] - emb[idx, :5].mean(0), axis=1) for idx in clusters]
+    for idx, linked in zip(clusters, link_clusters(clusters, costs, ps.src, ps.dst, n_nodes), strict=True):
         si, sj = int(sym[ps.src[idx[0]]]), int(sym[ps.dst[idx[0]]])
-        cost = np.linalg.norm(emb[idx, :5] - emb[idx, :5].mean(0), axis=1)
-        src, dst = ps.src[idx], ps.dst[idx]
-        chain_list, succ = chains(src, dst, cost)
-        if not chain_list:
+        chain_list, used = linked.chains, linked.used
+        if len(chain_list) == 0:
             continue
-        cluster = ConstantCluster((si, sj), idx, succ)
+        cluster = ConstantCluster((si, sj), idx, linked.src, linked.dst)
         found.append(cluster)
-        used = chain_pairs(chain_list, src, dst, idx)
         A, B = mean_rel(ps.A[used], ps.B[used])
-        lengths = [len(c) - 1 for c in chain_list]
-        if len(chain_list) < 2 and max(lengths) < 2:
+        lengths = chain_list.lengths - 1
+        if len(chain_list) < 2 and lengths.max() < 2:
             continue
         h, phi = float(np.mean(prox[used])), ctx.phi(si, sj)
         cand: Candidate
-        if si == sj and max(lengths) >= 2:
-            groups = tuple(np.array(c) for c in chain_list)
+        if si == sj and lengths.max() >= 2:
             cand = SeqCandidate(
-                space=(si, sj), groups=groups, h=h, phi=phi, l=float(np.mean(lengths)), A=A, B=B
+                space=(si, sj), groups=chain_list.arrays(), h=h, phi=phi, l=float(np.mean(lengths)), A=A, B=B
             )
         else:
-            pairs = tuple(np.array(c[:2]) for c in chain_list)
+            pairs = chain_list.head(2).arrays()
             cand = PairCandidate(space=(si, sj), groups=pairs, h=h, phi=phi, l=1.0, A=A, B=B)
             if si != sj:
                 pending.append((len(out), cluster))
@@ -116,7 +115,7 @@ def find_candidates(
         out[k] = replace(out[k], l=_alternation_length(cl.succ, by_space.get(cl.space[::-1], [])))
     same = {k: v for k, v in by_space.items() if k[0] == k[1]}
     out += branch_candidates(ps, same, prox, n_nodes)
-    out += linear_candidates(ctx, sym, ps, prox, size, key, ledger)
+    out += linear.result()
     return out
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from lsys_core.hierarchy.candidates import BranchCandidate, ConstantCluster, mean_rel
+from lsys_core.hierarchy.flat import isin
 from lsys_core.hierarchy.spaces import PairSpace
 
 __all__ = ["branch_candidates"]
@@ -24,7 +25,7 @@ def branch_candidates(
     """Return full binary trees made of two clusters of one symbol space sharing their first elements."""
     out = []
     for space, cls in clusters.items():
-        big = [c for c in cls if len(c.succ) >= 2][:_BRANCH_CLUSTERS]
+        big = [c for c in cls if c.src.size >= 2][:_BRANCH_CLUSTERS]
         for x in range(len(big)):
             for y in range(x + 1, len(big)):
                 cand = _trees(ps, space, big[x], big[y], prox, n_nodes)
@@ -33,18 +34,17 @@ def branch_candidates(
     return out
 
 
-def _successors(succ: dict[int, int], n_nodes: int) -> np.ndarray:
+def _successors(cl: ConstantCluster, n_nodes: int) -> np.ndarray:
     c = np.full(n_nodes, -1)
-    if succ:
-        c[np.fromiter(succ.keys(), int)] = np.fromiter(succ.values(), int)
+    c[cl.src] = cl.dst
     return c
 
 
 def _trees(ps, space, one: ConstantCluster, two: ConstantCluster, prox, n_nodes) -> BranchCandidate | None:
-    if not set(one.succ) & set(two.succ):
+    if not isin(one.src, two.src).any():
         return None
-    c1 = _successors(one.succ, n_nodes)
-    c2 = _successors(two.succ, n_nodes)
+    c1 = _successors(one, n_nodes)
+    c2 = _successors(two, n_nodes)
     depth = np.zeros(n_nodes, int)
     has = (c1 >= 0) & (c2 >= 0)
     for _ in range(64):
@@ -52,24 +52,15 @@ def _trees(ps, space, one: ConstantCluster, two: ConstantCluster, prox, n_nodes)
         if np.array_equal(new, depth):
             break
         depth = new
-    trees: list[tuple[int, np.ndarray]] = []
-    covered = np.zeros(n_nodes, bool)
-    for r in np.argsort(-depth, kind="stable"):
-        if depth[r] < 1 or covered[r]:
-            continue
-        dep = min(int(depth[r]), int(np.log2(n_nodes + 1)) - 1)
-        nodes = _tree_nodes(int(r), dep, c1, c2)
-        while dep >= 1 and (nodes is None or covered[nodes].any()):
-            dep -= 1
-            nodes = _tree_nodes(int(r), dep, c1, c2)
-        if dep < 1 or nodes is None:
-            continue
-        covered[nodes] = True
-        trees.append((dep, nodes))
+    trees = _greedy_trees(depth, int(np.log2(n_nodes + 1)) - 1, c1, c2)
     if not trees or (len(trees) < 2 and trees[0][0] < 2):
         return None
-    used1 = np.array([k for k in one.pairs if covered[ps.src[k]] and c1[ps.src[k]] == ps.dst[k]])
-    used2 = np.array([k for k in two.pairs if covered[ps.src[k]] and c2[ps.src[k]] == ps.dst[k]])
+    covered = np.zeros(n_nodes, bool)
+    for _, nodes in trees:
+        covered[nodes] = True
+    s1, s2 = ps.src[one.pairs], ps.src[two.pairs]
+    used1 = one.pairs[covered[s1] & (c1[s1] == ps.dst[one.pairs])]
+    used2 = two.pairs[covered[s2] & (c2[s2] == ps.dst[two.pairs])]
     if used1.size == 0 or used2.size == 0:
         return None
     return BranchCandidate(
@@ -84,12 +75,38 @@ def _trees(ps, space, one: ConstantCluster, two: ConstantCluster, prox, n_nodes)
     )
 
 
-def _tree_nodes(root: int, depth: int, c1: np.ndarray, c2: np.ndarray) -> np.ndarray | None:
-    """Nodes of the full binary tree of ``depth`` under ``root`` (root first), or None if not distinct."""
-    level = np.array([root])
-    nodes = [level]
-    for _ in range(depth):
-        level = np.concatenate([c1[level], c2[level]])
-        nodes.append(level)
-    out = np.concatenate(nodes)
-    return out if np.unique(out).size == out.size and (out >= 0).all() else None
+def _greedy_trees(
+    depth: np.ndarray, cap: int, c1: np.ndarray, c2: np.ndarray
+) -> list[tuple[int, np.ndarray]]:
+    """Disjoint full binary trees, deepest roots first, each as deep as it stays valid (≤ ``cap``).
+
+    A tree of depth ``d`` under a root is valid when its ``2^(d+1) - 1`` nodes exist, are
+    distinct and not yet covered; validity at ``d`` implies it at every smaller depth, so each
+    tree grows level by level until the next level would break it (root first, then each
+    level's left children, then its right children).
+    """
+    order = np.argsort(-depth, kind="stable")
+    roots = order[depth[order] >= 1].tolist()
+    most = np.minimum(depth, cap).tolist()
+    left, right = c1.tolist(), c2.tolist()
+    covered = bytearray(depth.size)
+    trees = []
+    for r in roots:
+        if covered[r]:
+            continue
+        levels = [[r]]
+        seen = {r}
+        for _ in range(most[r]):
+            last = levels[-1]
+            nxt = [left[v] for v in last] + [right[v] for v in last]
+            if any(v < 0 or covered[v] or v in seen for v in nxt) or len(set(nxt)) != len(nxt):
+                break
+            seen.update(nxt)
+            levels.append(nxt)
+        if len(levels) < 2:
+            continue
+        nodes = [v for lev in levels for v in lev]
+        for v in nodes:
+            covered[v] = 1
+        trees.append((len(levels) - 1, np.array(nodes)))
+    return trees

@@ -10,6 +10,7 @@ They are found by :mod:`lsys_core.hierarchy.analysis`.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 from typing import Protocol
 
 import numpy as np
@@ -161,8 +162,18 @@ def proximity(ps: PairSpace, n_nodes: int, radius: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True, eq=False)
 class ConstantCluster:
-    """A cluster *C* of pairs with one transform, linked into chains (input of the other finders)."""
+    """A cluster *C* of pairs with one transform, linked into chains (input of the other finders).
+
+    ``pairs`` are the cluster's pair indices; the links ``src[k] → dst[k]`` are the successor
+    map its chains were followed from (each node with ≤ 1 successor and predecessor).
+    """
 
     space: tuple[int, int]
     pairs: np.ndarray
-    succ: dict[int, int]
+    src: np.ndarray
+    dst: np.ndarray
+
+    @cached_property
+    def succ(self) -> dict[int, int]:
+        """The links as a successor map."""
+        return dict(zip(self.src.tolist(), self.dst.tolist(), strict=True))

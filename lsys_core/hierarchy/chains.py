@@ -2,14 +2,97 @@
 
 A cluster of pairs ``i → j`` with one transform links into chains when the second node of a
 pair is the first of another.  Each node gets at most one successor and one predecessor;
-closed loops (a ring) keep all their nodes and drop the pair that closes them.
+closed loops (a ring) keep all their nodes and drop the pair that closes them.  All clusters
+of a level are linked at once with the flat primitives of :mod:`lsys_core.hierarchy.flat`.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-__all__ = ["chain_pairs", "chains", "edge_chains", "follow", "successor_pairs"]
+from lsys_core.hierarchy.flat import Groups, follow_links, greedy_links, isin, sorted_unique
+
+__all__ = ["Linked", "chains", "edge_chains", "edge_groups", "follow", "link_clusters", "successor_pairs"]
+
+
+@dataclass(frozen=True, eq=False)
+class Linked:
+    """One cluster's pairs linked into chains.
+
+    Attributes
+    ----------
+    chains : Groups
+        Open paths (from their first nodes, in node order), then rings (from their smallest node).
+    used : ndarray of int
+        The pair linking every two consecutive nodes of the chains, chain by chain.
+    src, dst : ndarray of int
+        The links taken: the successor map the chains were followed from.
+    """
+
+    chains: Groups
+    used: np.ndarray
+    src: np.ndarray
+    dst: np.ndarray
+
+
+def link_clusters(
+    clusters: list[np.ndarray], costs: list[np.ndarray], src: np.ndarray, dst: np.ndarray, n_nodes: int
+) -> list[Linked]:
+    """Link every cluster's pairs into sequences, all clusters at once.
+
+    Per cluster, pairs are taken greedily from the cheapest (ties in pair order), each node
+    keeping ≤ 1 successor and ≤ 1 predecessor, and the links are followed into chains.
+
+    Parameters
+    ----------
+    clusters : list of ndarray of int
+        The pair indices of every cluster, increasing.
+    costs : list of ndarray of float
+        The cost of every pair of every cluster.
+    src, dst : ndarray of int
+        First and second node of every pair.
+    n_nodes : int
+        Number of nodes.
+    """
+    count = len(clusters)
+    if count == 0:
+        return []
+    n = np.int64(max(n_nodes, 1))
+    items = np.concatenate(clusters)
+    cid = np.repeat(np.arange(count, dtype=np.int64), [c.size for c in clusters])
+    order = np.lexsort((np.concatenate(costs), cid))  # per cluster by cost; ties in pair order
+    s_key = cid * n + src[items]
+    d_key = cid * n + dst[items]
+    both = np.concatenate([s_key, d_key])
+    uniq = sorted_unique(both)
+    k = np.searchsorted(uniq, both)
+    ok = s_key != d_key
+    acc = np.flatnonzero(greedy_links([k[: items.size], k[items.size :]], order[ok[order]], uniq.size))
+    a_src, a_dst = s_key[acc], d_key[acc]
+    starts = sorted_unique(a_src[~isin(a_src, a_dst)])  # per cluster, in node order
+    paths, loops = follow_links(a_src, a_dst, starts)
+    allc = paths.concat(loops)
+    allc = allc.take(np.argsort(allc.firsts // n, kind="stable"))  # per cluster: paths, then rings
+    # The pair along every link of the chains: the taken pair leaving the link's first node.
+    srt = np.argsort(a_src)
+    lo, _ = allc.links()
+    used = items[acc[srt[np.searchsorted(a_src[srt], allc.nodes[lo])]]]
+    cuts_c = np.searchsorted(allc.firsts // n, np.arange(count + 1))
+    cuts_u = np.searchsorted(allc.nodes[lo] // n, np.arange(count + 1))
+    cuts_a = np.searchsorted(cid[acc], np.arange(count + 1))
+    out = []
+    for c in range(count):
+        c0, c1 = cuts_c[c], cuts_c[c + 1]
+        base = c * n
+        sub = Groups(
+            allc.nodes[allc.offsets[c0] : allc.offsets[c1]] - base,
+            allc.offsets[c0 : c1 + 1] - allc.offsets[c0],
+        )
+        a0, a1 = cuts_a[c], cuts_a[c + 1]
+        out.append(Linked(sub, used[cuts_u[c] : cuts_u[c + 1]], a_src[a0:a1] - base, a_dst[a0:a1] - base))
+    return out
 
 
 def chains(src: np.ndarray, dst: np.ndarray, cost: np.ndarray) -> tuple[list[list[int]], dict[int, int]]:
@@ -18,17 +101,12 @@ def chains(src: np.ndarray, dst: np.ndarray, cost: np.ndarray) -> tuple[list[lis
     Returns the chains (open paths, then rings cut before their smallest node) and the
     successor map they were followed from.
     """
-    order = np.argsort(cost, kind="stable")
-    succ: dict[int, int] = {}
-    pred: dict[int, int] = {}
-    for e in order.tolist():
-        i, j = int(src[e]), int(dst[e])
-        if i == j or i in succ or j in pred:
-            continue
-        succ[i] = j
-        pred[j] = i
-    paths, loops = follow(succ, sorted(i for i in succ if i not in pred))
-    return paths + loops, succ
+    src, dst = np.asarray(src, np.int64), np.asarray(dst, np.int64)
+    if src.size == 0:
+        return [], {}
+    n = int(max(src.max(), dst.max())) + 1
+    (linked,) = link_clusters([np.arange(src.size)], [np.asarray(cost, float)], src, dst, n)
+    return linked.chains.tolist(), dict(zip(linked.src.tolist(), linked.dst.tolist(), strict=True))
 
 
 def follow(succ: dict[int, int], starts) -> tuple[list[list[int]], list[list[int]]]:
@@ -36,30 +114,10 @@ def follow(succ: dict[int, int], starts) -> tuple[list[list[int]], list[list[int
 
     Returns the paths and the closed loops left over, each loop listed from its smallest item.
     """
-    paths: list[list[int]] = []
-    seen: set[int] = set()
-    for s0 in starts:
-        path = [s0]
-        while path[-1] in succ:
-            path.append(succ[path[-1]])
-        seen.update(path)
-        paths.append(path)
-    loops: list[list[int]] = []
-    for s0 in sorted(succ):
-        if s0 in seen:
-            continue
-        loop = [s0]
-        while succ[loop[-1]] != s0:
-            loop.append(succ[loop[-1]])
-        seen.update(loop)
-        loops.append(loop)
-    return paths, loops
-
-
-def chain_pairs(chain_list: list[list[int]], src: np.ndarray, dst: np.ndarray, idx: np.ndarray) -> np.ndarray:
-    """Return the pair indices (from ``idx``, with ends ``src``/``dst``) that link consecutive chain nodes."""
-    look = {(int(s), int(d)): int(k) for s, d, k in zip(src, dst, idx, strict=True)}
-    return np.array([look[(c[t], c[t + 1])] for c in chain_list for t in range(len(c) - 1)], int)
+    src = np.fromiter(succ.keys(), np.int64, len(succ))
+    dst = np.fromiter(succ.values(), np.int64, len(succ))
+    paths, loops = follow_links(src, dst, np.asarray(list(starts), np.int64))
+    return paths.tolist(), loops.tolist()
 
 
 def successor_pairs(src: np.ndarray, dst: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -75,15 +133,23 @@ def successor_pairs(src: np.ndarray, dst: np.ndarray, idx: np.ndarray) -> tuple[
     return e1[keep], e2[keep]
 
 
-def edge_chains(e1: np.ndarray, e2: np.ndarray) -> list[list[int]]:
-    """Follow links ``e1 → e2`` (each pair with at most one successor and predecessor) into chains."""
+def edge_groups(e1: np.ndarray, e2: np.ndarray) -> Groups:
+    """Follow links ``e1 → e2`` (each pair keeps its first successor and predecessor) into chains.
+
+    Paths come in the order of their first links; closed loops (a ring of dots) are cut
+    before their smallest pair and lose the closing one.
+    """
     _, first = np.unique(e1, return_index=True)
     e1, e2 = e1[np.sort(first)], e2[np.sort(first)]
     _, first = np.unique(e2, return_index=True)
     e1, e2 = e1[np.sort(first)], e2[np.sort(first)]
     keep = e1 != e2
-    nxt = dict(zip(e1[keep].tolist(), e2[keep].tolist(), strict=True))
-    has_prev = set(nxt.values())
-    paths, loops = follow(nxt, [s0 for s0 in nxt if s0 not in has_prev])
-    # Closed loops (a ring of dots): cut each before its smallest pair and drop the closing one.
-    return paths + [loop[:-1] for loop in loops if len(loop) > 2]
+    s, d = e1[keep], e2[keep]
+    paths, loops = follow_links(s, d, s[~isin(s, d)])
+    loops = loops.take(np.flatnonzero(loops.lengths > 2))
+    return paths.concat(loops.take_prefix(loops.lengths - 1))
+
+
+def edge_chains(e1: np.ndarray, e2: np.ndarray) -> list[list[int]]:
+    """:func:`edge_groups` as lists."""
+    return edge_groups(e1, e2).tolist()

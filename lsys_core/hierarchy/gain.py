@@ -22,6 +22,7 @@ from lsys_core.hierarchy.candidates import (
     SeqCandidate,
 )
 from lsys_core.hierarchy.emit import counters, rule_cases
+from lsys_core.hierarchy.flat import sorted_unique
 from lsys_core.hierarchy.mdl import (
     KIND_BITS,
     Precision,
@@ -186,9 +187,9 @@ def cluster_bounds(ledger: Ledger, labels: np.ndarray, src: np.ndarray, dst: np.
     n = len(ledger.nodes)
 
     def distinct(x: np.ndarray) -> np.ndarray:
-        return np.bincount(np.unique(lab * n + x) // n, minlength=n_lab)
+        return np.bincount(sorted_unique(lab * n + x) // n, minlength=n_lab)
 
-    both = np.bincount(np.unique(np.concatenate([lab * n + s, lab * n + d])) // n, minlength=n_lab)
+    both = np.bincount(sorted_unique(np.concatenate([lab * n + s, lab * n + d])) // n, minlength=n_lab)
     n_src, n_dst = distinct(s), distinct(d)
     fam_s = np.zeros(n_lab, int)
     fam_d = np.zeros(n_lab, int)

@@ -12,8 +12,9 @@ import numpy as np
 
 from lsys_core.geometry.transforms import wrap_deg
 from lsys_core.hierarchy.candidates import Context, LinearCandidate
-from lsys_core.hierarchy.chains import edge_chains, successor_pairs
+from lsys_core.hierarchy.chains import edge_groups, successor_pairs
 from lsys_core.hierarchy.clustering import group_indices, mean_shift
+from lsys_core.hierarchy.flat import Groups, greedy_disjoint, sorted_unique
 from lsys_core.hierarchy.gain import Ledger, cluster_bounds
 from lsys_core.hierarchy.spaces import PairSpace
 
@@ -66,7 +67,7 @@ def linear_candidates(
     lab2, _ = mean_shift(emb2)
     if ledger is not None:
         lab2 = _promising(ledger, lab2, e1, e2, ps)
-    out = []
+    problems: list[tuple[np.ndarray, np.ndarray, float, float]] = []
     taken: dict[int, int] = {}
     for g2 in group_indices(lab2):
         if g2.size < 2:
@@ -79,10 +80,8 @@ def linear_candidates(
         dB = float(np.rad2deg(np.arctan2(emb2[g2, 3].mean(), emb2[g2, 2].mean())))
         if abs(dA) < tol.angle and abs(dB) < tol.angle:
             continue  # constant transform: a cluster C already covers it
-        cand = _linear_chains(ctx, sym, ps, e1[g2], e2[g2], dA, dB, prox)
-        if cand is not None:
-            out.append(cand)
-    return out
+        problems.append((e1[g2], e2[g2], dA, dB))
+    return _linear_chains(ctx, sym, ps, problems, prox)
 
 
 def _promising(
@@ -97,10 +96,10 @@ def _promising(
     ok = labels >= 0
     lab = labels[ok]
     m = len(ps)
-    pairs = np.unique(np.concatenate([lab * m + e1[ok], lab * m + e2[ok]])) // m
+    pairs = sorted_unique(np.concatenate([lab * m + e1[ok], lab * m + e2[ok]])) // m
     n = len(ledger.nodes)
     nodes = (
-        np.unique(
+        sorted_unique(
             np.concatenate([lab * n + ps.src[e1[ok]], lab * n + ps.dst[e1[ok]], lab * n + ps.dst[e2[ok]]])
         )
         // n
@@ -113,46 +112,86 @@ def _promising(
     return np.where(ok & (bound[np.maximum(labels, 0)] > 0.0), labels, -1)
 
 
-def _linear_chains(ctx, sym, ps, e1, e2, dA, dB, prox) -> LinearCandidate | None:
-    chains_e = edge_chains(e1, e2)
-    # Node-disjoint chains only (greedy, longest first).
-    chains_e.sort(key=len, reverse=True)
-    taken: set[int] = set()
-    groups: dict[tuple, list] = {}
+def _linear_chains(ctx, sym, ps, problems, prox) -> list[LinearCandidate]:
+    """One candidate per step cluster: its longest node-disjoint chains of one length and start.
+
+    Every step cluster (links ``e1 → e2`` between consecutive pairs, steps ``dA``, ``dB``) is
+    an independent problem; all are solved at once on keys offset by the problem's index.
+    """
+    if not problems:
+        return []
+    n_pairs, n_nodes = np.int64(len(ps)), np.int64(sym.size)
+    pid = np.repeat(np.arange(len(problems), dtype=np.int64), [p[0].size for p in problems])
+    e1 = pid * n_pairs + np.concatenate([p[0] for p in problems])
+    e2 = pid * n_pairs + np.concatenate([p[1] for p in problems])
+    chains_e = edge_groups(e1, e2)
+    chains_e = chains_e.take(np.argsort(chains_e.firsts // n_pairs, kind="stable"))  # by problem
+    prob = chains_e.firsts // n_pairs
+    edges = chains_e.nodes % n_pairs
+    k_e = chains_e.lengths
+    # Node chains: the first pair's source, then every pair's destination (offset by problem).
+    offsets = chains_e.offsets + np.arange(len(chains_e) + 1)
+    nodes = np.empty(int(offsets[-1]), np.int64)
+    head = np.zeros(nodes.size, bool)
+    head[offsets[:-1]] = True
+    base = np.repeat(prob, k_e)
+    nodes[head] = ps.src[edges[chains_e.offsets[:-1]]] + prob * n_nodes
+    nodes[~head] = ps.dst[edges] + base * n_nodes
+    node_chains = Groups(nodes, offsets)
+    # Node-disjoint chains only (greedy, longest first, per problem).
+    order = np.argsort(prob * (int(k_e.max()) + 1) - k_e, kind="stable")
+    taken = greedy_disjoint(node_chains, order, int(n_nodes) * len(problems))
+    acc = order[taken[order]]
+    if acc.size == 0:
+        return []
     step_tol = max(ctx.tol.angle, 1e-6)
-    for ch in chains_e:
-        nodes = [int(ps.src[ch[0]])] + [int(ps.dst[e]) for e in ch]
-        if taken.intersection(nodes) or len(set(nodes)) != len(nodes):
+    first_e = edges[chains_e.offsets[:-1][acc]]
+    key = np.column_stack(
+        [prob[acc], k_e[acc], np.round(ps.alpha[first_e] / step_tol), np.round(ps.beta[first_e] / step_tol)]
+    )
+    _, first, inv, counts = np.unique(key, axis=0, return_index=True, return_inverse=True, return_counts=True)
+    inv = inv.ravel()
+    # Per problem, the most populated (length, start) group (the first such group on ties).
+    kq, pq = k_e[acc][first], prob[acc][first]
+    rank = np.lexsort((first, -kq, -counts * kq, pq))
+    win = rank[np.r_[True, pq[rank][1:] != pq[rank][:-1]]]
+    winning = np.zeros(first.size, bool)
+    winning[win] = True
+    best = acc[winning[inv]]  # the winners' chains, per problem in greedy order
+    cuts = np.searchsorted(prob[best], np.arange(len(problems) + 1))
+    out = []
+    for p, (_, _, dA, dB) in enumerate(problems):
+        chosen = best[cuts[p] : cuts[p + 1]]
+        if chosen.size == 0 or (chosen.size < 2 and k_e[chosen[0]] < 2):
             continue
-        taken.update(nodes)
-        k = len(ch)
-        kq = (k, round(float(ps.alpha[ch[0]]) / step_tol), round(float(ps.beta[ch[0]]) / step_tol))
-        groups.setdefault(kq, []).append((nodes, ch))
-    if not groups:
-        return None
-    # One candidate: the most populated (length, start) group; others follow in later levels.
-    _, best = max(groups.items(), key=lambda kv: (len(kv[1]) * kv[0][0], kv[0][0]))
-    if len(best) < 2 and len(best[0][1]) < 2:
-        return None
-    edges = np.array([e for _, ch in best for e in ch])
-    step = np.array([t for _, ch in best for t in range(len(ch))])
-    al = np.array([float(ps.alpha[ch[0]]) for _, ch in best])
-    be = np.array([float(ps.beta[ch[0]]) for _, ch in best])
+        cand = _candidate(
+            sym, ps, prox, chains_e.take(chosen), node_chains.take(chosen), n_pairs, n_nodes, dA, dB
+        )
+        out.append(cand)
+    return out
+
+
+def _candidate(sym, ps, prox, chains_e, node_chains, n_pairs, n_nodes, dA, dB) -> LinearCandidate:
+    edges = chains_e.nodes % n_pairs
+    steps = int(chains_e.lengths[0])
+    step = np.arange(edges.size) - np.repeat(chains_e.offsets[:-1], chains_e.lengths)
+    al = ps.alpha[chains_e.firsts % n_pairs]
+    be = ps.beta[chains_e.firsts % n_pairs]
     # Least-squares fit of α0, β0 given the steps (angles unwrapped around the first chain).
     al_fit = float(np.mean(wrap_deg(ps.alpha[edges] - step * dA - al[0]))) + al[0]
     be_fit = float(np.mean(wrap_deg(ps.beta[edges] - step * dB - be[0]))) + be[0]
     si = int(sym[ps.src[edges[0]]])
     return LinearCandidate(
         space=(si, si),
-        groups=tuple(np.array(nodes) for nodes, _ in best),
+        groups=Groups(node_chains.nodes % n_nodes, node_chains.offsets).arrays(),
         h=float(np.mean(prox[edges])),
         phi=1.0,
-        l=float(len(best[0][1])),
+        l=float(steps),
         alpha0=al_fit,
         d=float(np.mean(ps.d[edges])),
         s=float(np.exp(np.mean(np.log(ps.s[edges])))),
         beta0=be_fit,
         d_alpha=dA,
         d_beta=dB,
-        steps=len(best[0][1]),
+        steps=steps,
     )

@@ -26,6 +26,7 @@ import numpy as np
 from lsys_core.cancel import CancelToken, Progress, check, report
 from lsys_core.grammar.model import Case, Module, Pop, Push, Rule, Symbol
 from lsys_core.hierarchy.analysis import find_candidates
+from lsys_core.hierarchy.cache import LevelCache
 from lsys_core.hierarchy.candidates import Candidate, SeqCandidate
 from lsys_core.hierarchy.emit import const_t, const_t_many, emit
 from lsys_core.hierarchy.gain import Ledger, placement_error
@@ -134,6 +135,7 @@ def build_hierarchy(
     cancel: CancelToken | None = None,
     progress: Progress | None = None,
     timer: dict[str, float] | None = None,
+    cache: LevelCache | None = None,
 ) -> Hierarchy:
     """Generate rules level by level until one node is left (§5.5–§5.6).
 
@@ -158,6 +160,9 @@ def build_hierarchy(
         rotations that do not show are not counted as deviations.
     timer
         If given, seconds spent are added under ``transforms``, ``clustering`` and ``rules``.
+    cache
+        If given, every level's candidates are looked up in it first and stored in it
+        (they do not depend on ``weights``: re-weighting reuses them).
 
     Returns
     -------
@@ -188,11 +193,18 @@ def build_hierarchy(
         check(cancel)
         report(progress, "rules", 1.0 - (len(nodes) - 1) / max(n0 - 1, 1))
         t0 = time.perf_counter()
-        ps = pair_space(nodes.a, nodes.b, nodes.center, nodes.radius, k=neighbours)
-        t1 = time.perf_counter()
         period = np.concatenate([term_period, np.zeros(len(table) - nt)])
         ledger = Ledger(prec, nodes, table)
-        cands = find_candidates(ctx, nodes.sym, ps, nodes.radius, ledger)
+        key = _level_key(table, nodes, tol, neighbours, prec) if cache is not None else b""
+        found = cache.get(key) if cache is not None else None
+        t1 = time.perf_counter()
+        if found is None:
+            ps = pair_space(nodes.a, nodes.b, nodes.center, nodes.radius, k=neighbours)
+            t1 = time.perf_counter()
+            found = find_candidates(ctx, nodes.sym, ps, nodes.radius, ledger)
+            if cache is not None:
+                cache.put(key, found)
+        cands = found
         t2 = time.perf_counter()
         chosen: list[Candidate] = []
         if cands and level < MAX_LEVELS:
@@ -211,6 +223,22 @@ def build_hierarchy(
     axiom = _axiom(table, book, nodes)
     report(progress, "rules", 1.0)
     return Hierarchy(tuple(book.rules), axiom, level, book.node_rule, tuple(book.log), closed=len(nodes) == 1)
+
+
+def _level_key(table: SymbolTable, nodes: Nodes, tol: Tolerance, neighbours: int, prec: Precision) -> bytes:
+    """What a level's candidates depend on: nodes, symbols (sizes, families, kinds), bandwidths, precision."""
+    terminal = np.arange(len(table)) < table.n_terminals
+    arrays = [
+        nodes.sym,
+        nodes.a,
+        nodes.b,
+        nodes.center,
+        nodes.radius,
+        table.sizes,
+        table.families(),
+        terminal,
+    ]
+    return LevelCache.key(arrays, (tol, neighbours, repr(prec)))
 
 
 def _axiom(table: SymbolTable, book: _Book, nodes: Nodes) -> tuple[Module, ...]:

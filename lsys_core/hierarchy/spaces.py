@@ -14,6 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from lsys_core.hierarchy.flat import sorted_unique
+from lsys_core.parallel import jobs
+
 __all__ = ["PairSpace", "pair_space"]
 
 
@@ -75,7 +78,7 @@ def pair_space(
         return PairSpace(e, e, z.astype(complex), z.astype(complex), z, z, z, z, z, z)
     kk = min(k, n - 1)
     pts = np.column_stack([center.real, center.imag])
-    _, idx = cKDTree(pts).query(pts, k=kk + 1)
+    _, idx = cKDTree(pts).query(pts, k=kk + 1, workers=jobs())
     idx = np.atleast_2d(idx)
     src = np.repeat(np.arange(n), kk + 1)
     dst = idx.ravel()
@@ -83,7 +86,7 @@ def pair_space(
     src, dst = src[keep], dst[keep]
     # Symmetrise: keep both directions of every neighbour pair, once each.
     both = np.concatenate([src * n + dst, dst * n + src])
-    both = np.unique(both)
+    both = sorted_unique(both)
     src, dst = both // n, both % n
     A = a[dst] / a[src]
     B = (b[dst] - b[src]) / a[src]

@@ -27,6 +27,7 @@ from lsys_core.instancing.exact import EXACT_TOL, fit_exact, structure_key, vari
 from lsys_core.instancing.match import PERFECT, Batch, Reference, match_batch
 from lsys_core.instancing.model import Instancing
 from lsys_core.instancing.sampling import Samples, arc_fractions, element_features, sample_elements
+from lsys_core.parallel import pmap
 from lsys_core.svg.model import Element, Scene
 
 __all__ = ["detect_similarity", "symmetry_order", "terminal_name", "terminal_similarity"]
@@ -148,12 +149,14 @@ def _sample_all(elements, fractions, cancel, progress=None) -> Samples:
     (closed outlines are matched through foot points, where sample placement does not matter).
     """
     precise = np.array([len(e.closed) == 1 and not e.closed[0] for e in elements], dtype=bool)
-    parts = []
-    for lo in range(0, len(elements), 4 * _CHUNK):
+
+    def chunk(lo: int) -> Samples:
         check(cancel)
         hi = lo + 4 * _CHUNK
-        parts.append(sample_elements(elements[lo:hi], fractions, precise[lo:hi]))
-        report(progress, _STAGE, 0.1 * min(hi, len(elements)) / len(elements))
+        return sample_elements(elements[lo:hi], fractions, precise[lo:hi])
+
+    parts = pmap(chunk, range(0, len(elements), 4 * _CHUNK))  # fixed chunks: same samples for any jobs
+    report(progress, _STAGE, 0.1)
     return Samples(*(np.concatenate([getattr(p, f) for p in parts]) for f in Samples.__dataclass_fields__))
 
 
@@ -346,14 +349,19 @@ def detect_similarity(
         cands = members[np.array(tree.query_ball_point(desc[r], tol, p=np.inf), dtype=int)]
         cands = np.sort(cands[group[cands] < 0])
         flipped: list[np.ndarray] = []
-        for lo in range(0, cands.size, _CHUNK):
+
+        def verify(chunk: np.ndarray, rep=rep, mirror=mirror):
+            """Match one chunk of candidates against the representative (chunks are independent)."""
             check(cancel)
-            chunk = cands[lo : lo + _CHUNK]
             ok, phi, gap, pa, pb = matcher.match(rep, chunk, threshold, mirrored=False)
+            mirrored = np.zeros(chunk.size, bool)
             if flips and mirror < 0:
                 mirrored = matcher.prefer_mirror(rep, chunk, threshold, ok, phi, gap)
-                flipped.append(chunk[mirrored])
-                ok &= ~mirrored
+            return ok & ~mirrored, mirrored, pa, pb
+
+        chunks = [cands[lo : lo + _CHUNK] for lo in range(0, cands.size, _CHUNK)]
+        for chunk, (ok, mirrored, pa, pb) in zip(chunks, pmap(verify, chunks), strict=True):
+            flipped.append(chunk[mirrored])
             group[chunk[ok]] = g
             a[chunk[ok]], b[chunk[ok]] = pa[ok], pb[ok]
             report(progress, _STAGE, 0.1 + 0.85 * float(np.count_nonzero(group >= 0)) / n)

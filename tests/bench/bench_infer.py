@@ -1,18 +1,26 @@
-"""Inference speed: whole `lsys infer` process and per-stage times, with a scaling table.
+"""Inference speed at scale: the whole `lsys infer` process on rotating grids of leaves.
 
-Run with `make bench` (or directly).  Prints medians over several runs, the machine's core
-count, and the peak memory of the process.
+Run with `make bench` (or directly).  One line per case: elements, wall seconds, peak memory
+of the process tree (proportional set size, so pages shared between workers count once),
+worker jobs, cores seen, the growth exponent from the previous size, the load average when the
+case started, and the per-stage seconds of the report.  A last line compares 2 jobs with 1.
+
+Environment: ``BENCH_SIZES`` (default ``1200,20000,50000,100000``), ``BENCH_REPEATS`` (median
+over runs for sizes up to 5,000; default 3), ``BENCH_SPEEDUP_N`` (default 50000; 0 skips the
+jobs comparison), ``BENCH_NICE`` (niceness of the measured process, default 5).  The number of
+jobs is passed as ``LSYS_JOBS`` (default: the cores this process may use).
 """
 
 from __future__ import annotations
 
 import json
+import math
 import os
-import resource
 import statistics
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -22,39 +30,132 @@ from scenes import grid_dims, rotating_grid_svg, write
 LSYS = [sys.executable, "-m", "lsys_core.cli"]
 
 
-def run_once(svg: Path, tmp: Path) -> tuple[float, dict, float]:
+def cores() -> int:
+    """Cores this process may run on (affinity), as the inference counts them."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        return os.cpu_count() or 1
+
+
+def _tree(pid: int) -> list[int]:
+    """``pid`` and all its descendants (Linux ``/proc``; just ``pid`` elsewhere)."""
+    out, todo = [], [pid]
+    while todo:
+        p = todo.pop()
+        out.append(p)
+        try:
+            for task in os.listdir(f"/proc/{p}/task"):
+                todo += [int(c) for c in Path(f"/proc/{p}/task/{task}/children").read_text().split()]
+        except OSError:
+            pass
+    return out
+
+
+def _memory(pid: int) -> float:
+    """Proportional set size of the process tree in MiB (resident size where Pss is unknown)."""
+    total = 0.0
+    for p in _tree(pid):
+        try:
+            text = Path(f"/proc/{p}/smaps_rollup").read_text()
+        except OSError:
+            continue
+        for line in text.splitlines():
+            if line.startswith("Pss:"):
+                total += int(line.split()[1]) / 1024
+                break
+    return total
+
+
+class _Peak(threading.Thread):
+    """Samples the memory of a process tree every 20 ms and keeps the largest total."""
+
+    def __init__(self, pid: int):
+        super().__init__(daemon=True)
+        self.pid, self.peak, self.done = pid, 0.0, threading.Event()
+
+    def run(self) -> None:
+        while not self.done.wait(0.02):
+            self.peak = max(self.peak, _memory(self.pid))
+
+
+def run_once(svg: Path, tmp: Path, jobs: int) -> tuple[float, float, dict]:
+    """Run ``lsys infer`` once; return wall seconds, peak MiB and the JSON report."""
     rep = tmp / "rep.json"
+    env = {**os.environ, "LSYS_JOBS": str(jobs)}
+    nice = int(os.environ.get("BENCH_NICE", "5"))
+    cmd = [*LSYS, "-q", "infer", str(svg), "-o", str(tmp / "r.lsys"), "--report", str(rep)]
     t = time.perf_counter()
-    p = subprocess.run(
-        [*LSYS, "infer", str(svg), "-o", str(tmp / "r.lsys"), "--report", str(rep)],
-        capture_output=True,
+    p = subprocess.Popen(
+        cmd,
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=(lambda: os.nice(nice)) if nice else None,
     )
+    peak = _Peak(p.pid)
+    peak.start()
+    _, err = p.communicate()
     wall = time.perf_counter() - t
+    peak.done.set()
+    peak.join()
     if p.returncode:
-        raise SystemExit(p.stderr)
-    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
-    return wall, json.loads(rep.read_text()), peak
+        raise SystemExit(err)
+    return wall, peak.peak, json.loads(rep.read_text())
+
+
+def case(svg: Path, tmp: Path, n: int, jobs: int, repeats: int) -> tuple[float, float, dict, float]:
+    """Median wall seconds, peak MiB, first report and the load average at the start."""
+    load = os.getloadavg()[0]
+    runs = [run_once(svg, tmp, jobs) for _ in range(repeats if n <= 5000 else 1)]
+    return statistics.median(r[0] for r in runs), max(r[1] for r in runs), runs[0][2], load
+
+
+def line(n: int, sec: float, mib: float, jobs: int, expo: str, load: float, rep: dict) -> str:
+    stages = " ".join(f"{k}={v:.2f}" for k, v in rep["stages"].items() if k != "reproduction_error")
+    return (
+        f"{n:>8} {sec:>8.2f} {mib:>8.0f} {jobs:>4} {cores():>5} {expo:>8} {load:>5.1f} "
+        f"{len(rep['rules']):>5}  {stages}"
+    )
 
 
 def main() -> None:
-    sizes = [int(x) for x in os.environ.get("BENCH_SIZES", "300,1200,5000,20000").split(",")]
+    sizes = [int(x) for x in os.environ.get("BENCH_SIZES", "1200,20000,50000,100000").split(",")]
     repeats = int(os.environ.get("BENCH_REPEATS", "3"))
-    print(f"inference benchmark: rotating grid, {os.cpu_count()} cores, median of {repeats} runs")
-    print(f"{'elements':>9} {'process s':>10} {'peak MiB':>9} {'rules':>6}  stages (s)")
+    speed_n = int(os.environ.get("BENCH_SPEEDUP_N", "50000"))
+    jobs = int(os.environ.get("LSYS_JOBS", "0")) or cores()
+    print(f"inference at scale: whole `lsys infer` on a rotating grid of leaves, {cores()} cores seen")
+    print(
+        f"{'n':>8} {'seconds':>8} {'peak MiB':>8} {'jobs':>4} {'cores':>5} {'exponent':>8} {'load':>5} {'rules':>5}  stages (s)"
+    )
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
+        svgs = {}
+        prev: tuple[int, float] | None = None
+        results: dict[int, float] = {}
         for n in sizes:
             rows, cols = grid_dims(n)
-            svg = write(tmp / f"grid{n}.svg", rotating_grid_svg(rows, cols))
-            runs = [run_once(svg, tmp) for _ in range(repeats if n <= 5000 else 1)]
-            wall = statistics.median(r[0] for r in runs)
-            rep = runs[0][1]
-            stages = " ".join(f"{k}={v:.3f}" for k, v in rep["stages"].items() if k != "reproduction_error")
-            print(
-                f"{rows * cols:>9} {wall:>10.2f} {max(r[2] for r in runs):>9.0f} {len(rep['rules']):>6}  {stages}",
-                flush=True,
-            )
+            svgs[n] = write(tmp / f"grid{n}.svg", rotating_grid_svg(rows, cols))
+            sec, mib, rep, load = case(svgs[n], tmp, n, jobs, repeats)
+            m = rows * cols
+            expo = f"{math.log(sec / prev[1]) / math.log(m / prev[0]):.2f}" if prev else "-"
+            print(line(m, sec, mib, jobs, expo, load, rep), flush=True)
+            prev, results[m] = (m, sec), sec
+        big = [m for m in results if m >= 20000]
+        if len(big) >= 2:
+            lo, hi = min(big), max(big)
+            e = math.log(results[hi] / results[lo]) / math.log(hi / lo)
+            print(f"growth exponent {lo} -> {hi}: {e:.2f}")
+        if speed_n:
+            rows, cols = grid_dims(speed_n)
+            svg = svgs.get(speed_n) or write(tmp / f"grid{speed_n}.svg", rotating_grid_svg(rows, cols))
+            m = rows * cols
+            one = case(svg, tmp, m, 1, 1)
+            print(line(m, one[0], one[1], 1, "-", one[3], one[2]), flush=True)
+            two = case(svg, tmp, m, 2, 1)
+            print(line(m, two[0], two[1], 2, "-", two[3], two[2]), flush=True)
+            print(f"speed-up at {m}, 2 jobs vs 1: {one[0] / two[0]:.2f}x")
 
 
 if __name__ == "__main__":

@@ -141,7 +141,12 @@ def test_branch_candidates_build_full_binary_trees() -> None:
     look = {(int(s), int(d)): k for k, (s, d) in enumerate(zip(ps.src, ps.dst, strict=True))}
     idx1 = np.array([look[(s, d)] for s, d in left.items()])
     idx2 = np.array([look[(s, d)] for s, d in right.items()])
-    clusters = {(0, 0): [ConstantCluster((0, 0), idx1, left), ConstantCluster((0, 0), idx2, right)]}
+    clusters = {
+        (0, 0): [
+            ConstantCluster((0, 0), idx1, np.array(list(left)), np.array(list(left.values()))),
+            ConstantCluster((0, 0), idx2, np.array(list(right)), np.array(list(right.values()))),
+        ]
+    }
     found = branch_candidates(ps, clusters, np.ones(len(ps)), n)
     assert len(found) == 1
     tree = found[0]

@@ -1,0 +1,97 @@
+"""How many workers the inference uses, and an order-keeping parallel map on threads.
+
+The parallel parts of the inference are independent numpy-heavy tasks (sampling chunks of
+elements, matching chunks of candidates against a representative, the two kinds of cluster
+analysis of a level, the step clusters of every (d, s) cluster).  numpy releases the GIL in
+its array loops, so threads share the work without copying the scene into other processes;
+results never depend on the number of workers (every task computes the same thing, and the
+results are put back in order).
+
+The number of workers follows the cores this process may run on (``os.process_cpu_count()``
+or the CPU affinity), and can be set with the ``LSYS_JOBS`` environment variable or
+:func:`set_jobs` (the command's ``--jobs``).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Iterable
+from concurrent.futures import Future, ThreadPoolExecutor
+from typing import TypeVar
+
+from lsys_core.errors import LsysError
+
+__all__ = ["MAX_JOBS", "available_cores", "jobs", "pmap", "set_jobs", "submit"]
+
+#: Largest accepted number of workers.
+MAX_JOBS = 256
+#: The environment variable that sets the number of workers.
+ENV = "LSYS_JOBS"
+
+T = TypeVar("T")
+R = TypeVar("R")
+
+_override: int | None = None
+
+
+def available_cores() -> int:
+    """The cores this process may run on (affinity where the system tells it)."""
+    count = getattr(os, "process_cpu_count", None)
+    if count is not None:
+        return max(1, count() or 1)
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return max(1, os.cpu_count() or 1)
+
+
+def _parse(text: str, origin: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise LsysError(f"{origin} must be a whole number of workers, got {text!r}") from None
+    if not 1 <= n <= MAX_JOBS:
+        raise LsysError(f"{origin} must be between 1 and {MAX_JOBS}, got {n}")
+    return n
+
+
+def set_jobs(n: int | str | None) -> None:
+    """Use ``n`` workers from now on (None: back to ``LSYS_JOBS`` or the available cores)."""
+    global _override
+    _override = None if n is None else _parse(str(n), "--jobs")
+
+
+def jobs() -> int:
+    """The number of workers: :func:`set_jobs`, else ``LSYS_JOBS``, else the available cores."""
+    if _override is not None:
+        return _override
+    text = os.environ.get(ENV, "").strip()
+    return _parse(text, ENV) if text else available_cores()
+
+
+def pmap(fn: Callable[[T], R], items: Iterable[T], *, workers: int | None = None) -> list[R]:
+    """``[fn(x) for x in items]``, on up to ``workers`` (default :func:`jobs`) threads."""
+    todo = list(items)
+    n = min(workers if workers is not None else jobs(), len(todo))
+    if n <= 1:
+        return [fn(x) for x in todo]
+    with ThreadPoolExecutor(max_workers=n, thread_name_prefix="lsys") as pool:
+        return list(pool.map(fn, todo))
+
+
+def submit(fn: Callable[..., R], *args, **kwargs) -> Future[R]:
+    """Run ``fn(*args, **kwargs)`` beside the caller on a thread when there are ≥ 2 workers.
+
+    With one worker it runs at once; either way ``.result()`` gives its value (or raises).
+    """
+    if jobs() <= 1:
+        fut: Future[R] = Future()
+        try:
+            fut.set_result(fn(*args, **kwargs))
+        except BaseException as e:
+            fut.set_exception(e)
+        return fut
+    pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="lsys")
+    fut = pool.submit(fn, *args, **kwargs)
+    pool.shutdown(wait=False)
+    return fut

@@ -1,0 +1,90 @@
+"""The number of workers never changes the result: rules and derived drawing for 1 and 2 jobs."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from lsys_core import parallel
+from lsys_core.derive.derivation import derive
+from lsys_core.errors import LsysError
+from lsys_core.grammar import format_grammar
+from lsys_core.pipeline import infer
+
+from .scenes import LEAF, place, pose, scene
+from .shared import ROOT
+
+
+def _rotating_grid(rows: int, cols: int):
+    """A grid of leaves whose rotation grows 12° per column: several similarity chunks, linear rows."""
+    frames = [pose(40.0 * c, 40.0 * r, 12.0 * c) for r in range(rows) for c in range(cols)]
+    return scene(place(LEAF, frames))
+
+
+@pytest.fixture
+def restore_jobs():
+    yield
+    parallel.set_jobs(None)
+
+
+def test_rules_and_drawing_are_the_same_for_one_and_two_jobs(restore_jobs) -> None:
+    grid = _rotating_grid(30, 44)  # 1,320 elements: two chunks of candidates per representative
+    out = {}
+    for n in (1, 2):
+        parallel.set_jobs(n)
+        assert parallel.jobs() == n
+        result = infer(grid)
+        out[n] = (format_grammar(result.grammar), derive(result.grammar), result.log)
+    (g1, d1, log1), (g2, d2, log2) = out[1], out[2]
+    assert g1 == g2 and log1 == log2
+    assert np.array_equal(d1.symbol, d2.symbol)
+    assert np.array_equal(d1.a, d2.a) and np.array_equal(d1.b, d2.b)
+    assert d1.symbol.size == 30 * 44
+
+
+def test_pmap_keeps_order_and_raises_the_workers_errors(restore_jobs) -> None:
+    parallel.set_jobs(3)
+    assert parallel.pmap(lambda x: x * x, range(10)) == [x * x for x in range(10)]
+
+    def fail(x: int) -> int:
+        if x == 3:
+            raise ValueError("three")
+        return x
+
+    with pytest.raises(ValueError, match="three"):
+        parallel.pmap(fail, range(6))
+    with pytest.raises(ValueError, match="three"):
+        parallel.submit(fail, 3).result()
+    assert parallel.submit(fail, 2).result() == 2
+
+
+def test_jobs_follow_the_environment_and_reject_nonsense(monkeypatch, restore_jobs) -> None:
+    parallel.set_jobs(None)
+    monkeypatch.setenv("LSYS_JOBS", "3")
+    assert parallel.jobs() == 3
+    monkeypatch.delenv("LSYS_JOBS")
+    assert parallel.jobs() == parallel.available_cores() >= 1
+    for bad in ("0", "-2", "two", "100000"):
+        with pytest.raises(LsysError):
+            parallel.set_jobs(bad)
+    monkeypatch.setenv("LSYS_JOBS", "lots")
+    with pytest.raises(LsysError, match="LSYS_JOBS"):
+        parallel.jobs()
+
+
+def test_cli_jobs_option_and_variable(tmp_path) -> None:
+    svg = ROOT / "resources" / "examples" / "helix.svg"
+    env = {**os.environ, "LSYS_JOBS": "1"}
+    cmd = [sys.executable, "-m", "lsys_core.cli", "infer", str(svg)]
+    one = subprocess.run([*cmd, "--jobs", "1"], capture_output=True, text=True, timeout=300, env=env)
+    two = subprocess.run([*cmd, "--jobs", "2"], capture_output=True, text=True, timeout=300, env=env)
+    assert one.returncode == 0 and one.stdout == two.stdout
+    bad = subprocess.run([*cmd, "--jobs", "0"], capture_output=True, text=True, timeout=300, env=env)
+    assert bad.returncode != 0 and bad.stderr.count("\n") == 1 and "--jobs" in bad.stderr
+    env["LSYS_JOBS"] = "many"
+    bad = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=env)
+    assert bad.returncode != 0 and bad.stderr.count("\n") == 1 and "LSYS_JOBS" in bad.stderr

@@ -1,0 +1,75 @@
+"""Re-weighting from a kept analysis gives what a full inference with those weights gives."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import lsys_core.hierarchy.rules as rules_mod
+import lsys_core.instancing.similarity as similarity_mod
+from lsys_core.derive.derivation import derive
+from lsys_core.grammar import format_grammar
+from lsys_core.hierarchy.rules import Weights
+from lsys_core.pipeline import InferenceSettings, analyse, infer, rules_from_analysis
+from lsys_core.svg.parse import load_svg
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "resources" / "examples"
+WEIGHTS = [Weights(), Weights(1.0, 0.1, 0.0, 1.0), Weights(0.0, 1.0, 1.0, 0.0), Weights(0.5, 0.5, 0.5, 0.5)]
+
+
+def _same(r1, r2) -> None:
+    assert format_grammar(r1.grammar) == format_grammar(r2.grammar)
+    d1, d2 = derive(r1.grammar), derive(r2.grammar)
+    assert np.array_equal(d1.symbol, d2.symbol)
+    assert np.array_equal(d1.a, d2.a) and np.array_equal(d1.b, d2.b)
+    assert r1.log == r2.log
+
+
+@pytest.mark.parametrize("name", ["facade", "flower-ring", "tiled-ornament"])
+def test_rules_from_analysis_equal_full_runs_for_every_weight(name: str) -> None:
+    scene = load_svg(EXAMPLES / f"{name}.svg")
+    analysis = analyse(scene)
+    for w in WEIGHTS:
+        settings = InferenceSettings(wn=w.wn, wh=w.wh, wphi=w.wphi, wl=w.wl)
+        _same(rules_from_analysis(analysis, w), infer(scene, settings))
+
+
+def test_reweighting_runs_neither_similarity_nor_first_level_clustering_again(monkeypatch) -> None:
+    scene = load_svg(EXAMPLES / "facade.svg")
+    analysis = analyse(scene)
+    rules_from_analysis(analysis)
+    calls = {"similarity": 0, "levels": 0}
+
+    def counted(name, fn):
+        def wrapper(*args, **kwargs):
+            calls[name] += 1
+            return fn(*args, **kwargs)
+
+        return wrapper
+
+    monkeypatch.setattr(
+        similarity_mod, "detect_similarity", counted("similarity", similarity_mod.detect_similarity)
+    )
+    monkeypatch.setattr(rules_mod, "find_candidates", counted("levels", rules_mod.find_candidates))
+    hits = analysis.levels.hits
+    rules_from_analysis(analysis, Weights())
+    assert calls == {"similarity": 0, "levels": 0}  # same weights: every level is known
+    assert analysis.levels.hits > hits
+    rules_from_analysis(analysis, Weights(1.0, 0.1, 0.0, 1.0))
+    assert calls["similarity"] == 0  # other weights: at most the levels after another choice
+
+
+def test_analyse_reuses_what_a_setting_does_not_change() -> None:
+    scene = load_svg(EXAMPLES / "helix.svg")
+    first = analyse(scene)
+    looser = analyse(scene, InferenceSettings(tolerance=3.0), previous=first)
+    assert looser.instancing is first.instancing and looser.levels is first.levels
+    _same(rules_from_analysis(looser), infer(scene, InferenceSettings(tolerance=3.0)))
+    fewer = analyse(scene, InferenceSettings(neighbours=8), previous=first)
+    assert fewer.instancing is first.instancing and fewer.levels is not first.levels
+    other = analyse(scene, InferenceSettings(similarity=0.8), previous=first)
+    assert other.instancing is not first.instancing
+    elsewhere = analyse(load_svg(EXAMPLES / "helix.svg"), previous=first)
+    assert elsewhere.instancing is not first.instancing  # another scene object: analysed anew
