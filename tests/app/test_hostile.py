@@ -60,7 +60,7 @@ SVG_OK = {
     "non_finite": "skipped 2 elements: non-finite or huge coordinates",
     "huge_coordinates": None,
     "zero_length_paths": "skipped 4 elements: degenerate",
-    "malformed_path_data": "skipped 2 elements: malformed path data",
+    "malformed_path_data": "skipped 3 elements: malformed path data",  # "nan" is no number in path data
     "zero_viewbox": "ignored the viewBox '0 0 0 0'",
     "nested_zero_viewbox": "ignored the viewBox '0 0 0 0'",
     "degenerate_transforms": "skipped 2 elements: degenerate",
