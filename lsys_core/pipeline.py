@@ -14,13 +14,16 @@ import numpy as np
 
 from lsys_core.cancel import CancelToken, Progress, check, report
 from lsys_core.derive.derivation import derive
+from lsys_core.derive.model import Drawing
 from lsys_core.errors import InferenceError
 from lsys_core.grammar.model import Grammar
 from lsys_core.hierarchy.cache import LevelCache
-from lsys_core.hierarchy.mdl import Precision, grammar_bits
+from lsys_core.hierarchy.explain import explained_share
+from lsys_core.hierarchy.mdl import Precision, flat_bits, grammar_bits
 from lsys_core.hierarchy.pivots import estimate_pivots, recenter
 from lsys_core.hierarchy.postprocess import simplify
 from lsys_core.hierarchy.rules import Hierarchy, Tolerance, Weights, build_hierarchy
+from lsys_core.hierarchy.snap import SHARE
 from lsys_core.instancing.fidelity import split_unfaithful
 from lsys_core.instancing.model import Instancing
 from lsys_core.instancing.orientation import unwrap_symmetric
@@ -45,9 +48,10 @@ DEFAULT_DEVIATION = 0.005
 #: With tolerance 0 (exact copies only), rules still place elements to this share of the
 #: diagonal: the precision SVG coordinates are written at.
 EXACT_PLACEMENT = 1e-4
-#: Largest deviation (relative to the scene's diagonal) of an element from the terminal
-#: drawn in its place; elements farther from their group's shape get a terminal of their own.
-SHAPE_ERROR = 0.002
+#: :func:`symmetrize` lets shapes that deviate this many times the tolerance share a terminal,
+#: and rounds the rules' numbers within this share of its tolerance.
+SYMMETRIZE_SHAPES = 2.0
+SYMMETRIZE_SNAP = 0.5
 #: Scenes with more elements than this try fewer relaxed tolerances (see :func:`_factors`).
 LARGE_SCENE = 1000
 #: The tolerance of :func:`symmetrize`, whose purpose is to move elements onto a regular pattern
@@ -70,6 +74,11 @@ class InferenceSettings:
         Factor on the clustering bandwidths; larger values merge jittered repetitions.
     neighbours : int
         Neighbours per node in the transformation spaces.
+    deviation : float or None
+        The tolerance: how far (document units) the derived drawing may deviate from the
+        input, shapes and placements together.  Near-identical shapes within it share a
+        terminal, and rules must place their elements within it.  None: 0.5 % of the
+        drawing's diagonal (:data:`DEFAULT_DEVIATION`); 0: exact copies only.
     """
 
     wn: float = setting("wn").default
@@ -79,6 +88,7 @@ class InferenceSettings:
     similarity: float = setting("similarity").default
     tolerance: float = setting("tolerance").default
     neighbours: int = 24
+    deviation: float | None = None
 
     def relaxed(self, factor: float = RELAXED) -> InferenceSettings:
         """Return these settings with the tolerance multiplied by ``factor`` (for symmetrization)."""
@@ -94,18 +104,48 @@ class InferenceSettings:
             problem = check_setting(s.name, float(getattr(self, s.name)))
             if problem is not None:
                 raise InferenceError(problem)
+        if self.deviation is not None and not (0.0 <= self.deviation < np.inf):
+            raise InferenceError(f"deviation must be a length >= 0, got {self.deviation:g}")
         return self
 
 
 @dataclass(frozen=True, eq=False)
 class InferenceResult:
-    """What :func:`infer` returns: the grammar, the instancing and timings (seconds per stage)."""
+    """What :func:`infer` returns: the grammar, the instancing, timings and how good the rules are.
+
+    Attributes
+    ----------
+    grammar : Grammar
+        The inferred rules.
+    instancing : Instancing
+        Terminals and poses of the input elements (with each element's shape deviation).
+    stages : dict of str to float
+        Seconds per stage (and ``reproduction_error``, the placement error over the diagonal).
+    seconds : float
+        Total time.
+    log : tuple of str
+        One line per rule written.
+    tolerance : float
+        The tolerance used (document units).
+    max_deviation : float
+        Largest distance of a derived element from its input element (document units): its
+        shape's deviation plus the displacement of its pose, an upper bound.
+    explained : float
+        Share of the elements placed by repetition rules, not one by one.
+    description_bits : tuple of float
+        Description length before (every element its own shape, placed one by one) and
+        after (the grammar), in bits at the precision the tolerance implies.
+    """
 
     grammar: Grammar
     instancing: Instancing
     stages: dict[str, float]
     seconds: float
     log: tuple[str, ...] = field(default=())
+    tolerance: float = 0.0
+    max_deviation: float = 0.0
+    explained: float = 0.0
+    description_bits: tuple[float, float] = (0.0, 0.0)
 
 
 def _element_circles(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
@@ -130,10 +170,10 @@ def _shape_similarity(inst: Instancing, cancel: CancelToken | None) -> np.ndarra
     return terminal_similarity(inst.terminals, cancel=cancel)
 
 
-def _diagonal(center: np.ndarray, radius: np.ndarray) -> float:
-    lo = np.array([np.min(center.real - radius), np.min(center.imag - radius)])
-    hi = np.array([np.max(center.real + radius), np.max(center.imag + radius)])
-    return max(float(np.hypot(*(hi - lo))), 1e-12)
+def _bounds(scene: Scene) -> tuple[complex, complex]:
+    """Corners of the bounding box of all control points (it holds every outline)."""
+    pts = np.concatenate([e.cubics.reshape(-1) for e in scene.elements])
+    return complex(pts.real.min(), pts.imag.min()), complex(pts.real.max(), pts.imag.max())
 
 
 def _factors(settings: InferenceSettings, symmetrizing: bool, n: int) -> list[float]:
@@ -151,23 +191,22 @@ def _factors(settings: InferenceSettings, symmetrizing: bool, n: int) -> list[fl
     return [settings.tolerance * f for f in steps]
 
 
-def reproduction_error(inst: Instancing, sizes: np.ndarray, drawing) -> float:
-    """Largest displacement of an input element in ``drawing`` (document units).
+def _matched(inst: Instancing, sizes: np.ndarray, drawing) -> tuple[np.ndarray, np.ndarray] | None:
+    """The derived pose matched to every input element, or None when instances are missing.
 
     Each input element is matched to the nearest derived instance of its terminal (by
     position, and by rotation and scale at the shape's radius: copies turned about one point
-    share their position); the displacement counts the translation and the rotation/scale
-    change at the shape's radius.
-    Missing instances count as infinitely far.
+    share their position).
     """
     from scipy.spatial import cKDTree
 
-    worst = 0.0
+    a_out = np.zeros_like(inst.a)
+    b_out = np.zeros_like(inst.b)
     for g in range(len(inst.terminals)):
         mine = np.flatnonzero(inst.group == g)
         theirs = np.flatnonzero(drawing.symbol == g)
         if mine.size != theirs.size:
-            return float("inf")
+            return None
         if mine.size == 0:
             continue
 
@@ -176,9 +215,67 @@ def reproduction_error(inst: Instancing, sizes: np.ndarray, drawing) -> float:
 
         ta, tb = drawing.a[theirs], drawing.b[theirs]
         _, j = cKDTree(poses(ta, tb)).query(poses(inst.a[mine], inst.b[mine]))
-        err = np.abs(inst.b[mine] - tb[j]) + sizes[g] * np.abs(inst.a[mine] - ta[j])
-        worst = max(worst, float(err.max()))
-    return worst
+        a_out[mine], b_out[mine] = ta[j], tb[j]
+    return a_out, b_out
+
+
+def _displacements(inst: Instancing, sizes: np.ndarray, drawing) -> np.ndarray:
+    """How far every input element's pose moved in ``drawing`` (translation plus turn/scale at its reach)."""
+    matched = _matched(inst, sizes, drawing)
+    if matched is None:
+        return np.full(inst.a.size, np.inf)
+    a, b = matched
+    return np.abs(inst.b - b) + sizes[inst.group] * np.abs(inst.a - a)
+
+
+def reproduction_error(inst: Instancing, sizes: np.ndarray, drawing) -> float:
+    """Largest displacement of an input element's pose in ``drawing`` (document units; inf if one is missing)."""
+    d = _displacements(inst, sizes, drawing)
+    return float(d.max()) if d.size else 0.0
+
+
+def _deviation(
+    inst: Instancing, sizes: np.ndarray, drawing, shape_dev: np.ndarray, limit: float, measure
+) -> float:
+    """Largest distance of a derived element from its input element (document units).
+
+    The shape's deviation plus its pose's displacement bounds it; where that bound exceeds
+    ``limit``, the derived outline is measured.
+    """
+    matched = _matched(inst, sizes, drawing)
+    if matched is None:
+        return float("inf")
+    a, b = matched
+    bound = shape_dev + np.abs(inst.b - b) + sizes[inst.group] * np.abs(inst.a - a)
+    over = np.flatnonzero(bound > limit)
+    if over.size:
+        bound[over] = measure(over, a[over], b[over])
+    return float(bound.max()) if bound.size else 0.0
+
+
+def _measure(scene: Scene, inst: Instancing):
+    """``measure(elements, a, b)``: the deviation of input elements from their terminals at poses ``a, b``."""
+    from lsys_core.geometry.shapes import shape_arrays
+    from lsys_core.instancing.deviation import pose_deviations
+    from lsys_core.svg.model import Element
+
+    shapes = [Element(*shape_arrays(t.path)) for t in inst.terminals]
+
+    def measure(elements: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return pose_deviations([scene.elements[i] for i in elements], shapes, inst.group[elements], a, b)
+
+    return measure
+
+
+def _instancing(scene: Scene, settings: InferenceSettings, tolerance: float, cancel, progress) -> Instancing:
+    """Terminals and poses (§4.1–4.2): similar shapes within ``tolerance`` share a terminal, the medoid."""
+    from lsys_core.instancing.representative import medoids, regular_scales
+    from lsys_core.instancing.similarity import detect_similarity
+
+    inst = detect_similarity(scene, threshold=settings.similarity, cancel=cancel, progress=progress)
+    check(cancel)
+    inst = split_unfaithful(scene, inst, tolerance=tolerance, threshold=settings.similarity, cancel=cancel)
+    return regular_scales(scene, medoids(scene, inst, tolerance), tolerance)
 
 
 @dataclass(frozen=True, eq=False)
@@ -210,6 +307,8 @@ class Analysis:
         Candidates of the hierarchy levels met so far (filled by rule generation).
     stages : dict
         Seconds spent in the analysis stages.
+    symmetrizing : bool
+        Made for :func:`symmetrize` (shapes grouped at a relaxed tolerance).
     """
 
     scene: Scene
@@ -222,6 +321,7 @@ class Analysis:
     shape_similarity: np.ndarray
     levels: LevelCache
     stages: dict[str, float]
+    symmetrizing: bool = False
 
 
 def analyse(
@@ -229,18 +329,18 @@ def analyse(
     settings: InferenceSettings = InferenceSettings(),
     *,
     previous: Analysis | None = None,
+    symmetrizing: bool = False,
     cancel: CancelToken | None = None,
     progress: Progress | None = None,
 ) -> Analysis:
     """Analyse ``scene`` once for any number of rule generations (see :class:`Analysis`).
 
     With ``previous`` (an analysis of the same scene object), only what ``settings`` change
-    is computed again: a new similarity threshold redoes everything; a new number of
-    neighbours starts an empty level cache; new weights or a new tolerance reuse all of it
-    (the level cache is keyed by the bandwidths).
+    is computed again: a new similarity threshold or deviation redoes everything; a new number
+    of neighbours starts an empty level cache; new weights or a new tolerance reuse all of it
+    (the level cache is keyed by the bandwidths).  ``symmetrizing`` groups shapes at the
+    relaxed tolerance of :func:`symmetrize`.
     """
-    from lsys_core.instancing.similarity import detect_similarity
-
     settings = settings.validated()
     if not scene.elements:
         raise InferenceError("the scene has no drawable elements")
@@ -248,37 +348,33 @@ def analyse(
         previous is not None
         and previous.scene is scene
         and previous.settings.similarity == settings.similarity
+        and previous.settings.deviation == settings.deviation
+        and previous.symmetrizing == symmetrizing
     ):
         same = previous.settings.neighbours == settings.neighbours
         return replace(previous, settings=settings, levels=previous.levels if same else LevelCache())
     stages: dict[str, float] = {}
-    t = time.perf_counter()
-    inst = detect_similarity(scene, threshold=settings.similarity, cancel=cancel, progress=progress)
-    stages["similarity"] = time.perf_counter() - t
-    check(cancel)
     center, radius = _element_circles(scene)
+    box = _bounds(scene)
+    diag = max(abs(box[1] - box[0]), 1e-12)
+    eps = DEFAULT_DEVIATION * diag if settings.deviation is None else settings.deviation
+    eps = max(eps, EXACT_PLACEMENT * diag)  # 0: exact copies, placed as precisely as SVG writes them
     t = time.perf_counter()
-    inst = split_unfaithful(
-        scene,
-        inst,
-        radius,
-        threshold=settings.similarity,
-        absolute=SHAPE_ERROR * _diagonal(center, radius),
-        cancel=cancel,
-    )
-    stages["similarity"] += time.perf_counter() - t
+    inst = _instancing(scene, settings, SYMMETRIZE_SHAPES * eps if symmetrizing else eps, cancel, progress)
+    stages["similarity"] = time.perf_counter() - t
     sizes = np.zeros(len(inst.terminals))
     np.maximum.at(sizes, inst.group, radius / np.maximum(np.abs(inst.a), 1e-300))
     t = time.perf_counter()
-    diag = _diagonal(center, radius)
-    prec = Precision.of_circles(center, radius, max(DEFAULT_DEVIATION * diag, EXACT_PLACEMENT * diag))
+    prec = Precision.of_box(*box, eps)
     inst = unwrap_symmetric(inst)
     offsets = estimate_pivots(inst, sizes, tolerance=prec.eps)
     inst = recenter(inst, offsets)
     sizes = sizes + np.abs(offsets)  # how far each shape reaches from its (moved) origin
     stages["pivots"] = time.perf_counter() - t
     shape_sim = _shape_similarity(inst, cancel)
-    return Analysis(scene, settings, inst, sizes, center, radius, prec, shape_sim, LevelCache(), stages)
+    return Analysis(
+        scene, settings, inst, sizes, center, radius, prec, shape_sim, LevelCache(), stages, symmetrizing
+    )
 
 
 def rules_from_analysis(
@@ -315,10 +411,12 @@ def rules_from_analysis(
     scene, inst, sizes, prec = analysis.scene, analysis.instancing, analysis.sizes, analysis.precision
     t_all = time.perf_counter()
     stages = dict(analysis.stages)
-    diag = _diagonal(analysis.center, analysis.radius)
-    if symmetrizing:
-        prec = prec.relaxed(max(prec.eps, SYMMETRIZE_ERROR * diag))
-    best: tuple[Grammar, Hierarchy, float, float] | None = None
+    diag = prec.diagonal
+    limit = max(prec.eps, SYMMETRIZE_ERROR * diag) if symmetrizing else prec.eps
+    shape_dev = inst.deviation if inst.deviation is not None else np.zeros(inst.a.size)
+    slack = np.maximum(limit - shape_dev, 0.0)
+    measure = _measure(scene, inst)
+    best: tuple[Grammar, Hierarchy, float, float, Drawing] | None = None
     for factor in _factors(settings, symmetrizing, len(scene.elements)):
         check(cancel)
         hier = build_hierarchy(
@@ -333,6 +431,10 @@ def rules_from_analysis(
             tol=Tolerance().scaled(factor),
             similarity=analysis.shape_similarity,
             precision=prec,
+            tolerance=limit,
+            slack=slack,
+            snap=SYMMETRIZE_SNAP if symmetrizing else SHARE,
+            measure=measure,
             symmetry=inst.symmetry,
             neighbours=settings.neighbours,
             cancel=cancel,
@@ -342,21 +444,33 @@ def rules_from_analysis(
         )
         t = time.perf_counter()
         grammar = simplify(Grammar(inst.terminals, tuple(hier.rules), hier.axiom, scene.viewbox, scene.size))
-        error = reproduction_error(inst, sizes, derive(grammar, limit=max(10 * len(scene.elements), 1000)))
+        drawing = derive(grammar, limit=max(10 * len(scene.elements), 1000))
+        error = _deviation(inst, sizes, drawing, shape_dev, limit, measure)
         bits = grammar_bits(grammar, prec)
         stages["postprocess"] = stages.get("postprocess", 0.0) + time.perf_counter() - t
         # The first try is always kept; relaxed ones must stay within the tolerance and be shorter.
-        if best is None or (error <= prec.eps and (bits, error) < (best[3], best[2])):
-            best = (grammar, hier, error, bits)
+        if best is None or (error <= limit and (bits, error) < (best[3], best[2])):
+            best = (grammar, hier, error, bits, drawing)
         if hier.closed and not symmetrizing:
             break  # every element is explained by repetitions: no need to relax
         if hier.levels == 0 and len(scene.elements) > LARGE_SCENE:
             break  # nothing repeats at all in a large scene: relaxing would only find chance
     assert best is not None  # _factors is never empty and the first try is always kept
-    grammar, hier, error, _ = best
-    stages["reproduction_error"] = error / diag
+    grammar, hier, error, bits, drawing = best
+    stages["reproduction_error"] = reproduction_error(inst, sizes, drawing) / diag
     report(progress, "done", 1.0)
-    return InferenceResult(grammar, inst, stages, time.perf_counter() - t_all, tuple(hier.log))
+    segments = np.array([e.cubics.shape[0] for e in scene.elements])
+    return InferenceResult(
+        grammar,
+        inst,
+        stages,
+        time.perf_counter() - t_all,
+        tuple(hier.log),
+        tolerance=limit,
+        max_deviation=error,
+        explained=explained_share(grammar, drawing.rule),
+        description_bits=(flat_bits(prec, segments, analysis.radius), bits),
+    )
 
 
 def infer(
@@ -398,7 +512,7 @@ def infer(
     InferenceResult
     """
     t_all = time.perf_counter()
-    analysis = analyse(scene, settings, cancel=cancel, progress=progress)
+    analysis = analyse(scene, settings, symmetrizing=symmetrizing, cancel=cancel, progress=progress)
     result = rules_from_analysis(analysis, symmetrizing=symmetrizing, cancel=cancel, progress=progress)
     return replace(result, seconds=time.perf_counter() - t_all)
 

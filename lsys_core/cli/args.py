@@ -41,6 +41,14 @@ def _weights(p: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--jobs", metavar="N", help="worker threads (default: $LSYS_JOBS, else the cores available)"
     )
+    g.add_argument(
+        "--deviation",
+        type=float,
+        metavar="LENGTH",
+        help="how far the derived drawing may deviate from the input, in document units: near-identical "
+        "shapes within it share a terminal, rules place elements within it (default 0.5 %% of the "
+        "drawing's diagonal; 0: exact copies only)",
+    )
 
 
 def _png(p: argparse.ArgumentParser) -> None:

@@ -117,6 +117,7 @@ def _settings(args: argparse.Namespace):
     jobs()  # a bad LSYS_JOBS is reported before any work
 
     kw = {s.name: getattr(args, s.name) for s in SETTINGS}
+    kw["deviation"] = getattr(args, "deviation", None)
     return InferenceSettings(**{k: v for k, v in kw.items() if v is not None}).validated()
 
 
@@ -217,6 +218,17 @@ def _timings(result) -> dict[str, float]:
     return {k: v for k, v in result.stages.items() if k not in _NOT_TIMINGS}
 
 
+def _summary(result, scene) -> str:
+    """One line: elements, productions, how much repetition explains, deviation and description length."""
+    before, after = result.description_bits
+    return (
+        f"lsys: inferred {len(scene.elements)} elements with {result.grammar.production_count} productions, "
+        f"{100 * result.explained:.0f} % placed by repetition, "
+        f"max deviation {result.max_deviation:.3g} (tolerance {result.tolerance:.3g}), "
+        f"{before:.0f} -> {after:.0f} bits"
+    )
+
+
 def _infer_report(result, scene, drawing) -> dict:
     from lsys_core.grammar import format_grammar
 
@@ -236,6 +248,13 @@ def _infer_report(result, scene, drawing) -> dict:
         "seconds": round(result.seconds, 4),
         "stages": {k: round(v, 4) for k, v in _timings(result).items()},
         "reproduction_error": result.stages.get("reproduction_error"),
+        "tolerance": result.tolerance,
+        "max_deviation": result.max_deviation,
+        "explained": round(result.explained, 4),
+        "description_bits": {
+            "before": round(result.description_bits[0], 1),
+            "after": round(result.description_bits[1], 1),
+        },
         "warnings": list(scene.warnings),
         "log": list(result.log),
     }
@@ -285,6 +304,8 @@ def _cmd_infer(args, progress: Progress, say: Say, symmetrize: bool = False) -> 
         if not args.output and not args.report and STDIO not in outputs:
             files.append((STDIO, text))
     _commit(files)
+    if not args.quiet:
+        say(_summary(result, scene))
     if args.verbose:
         for k, v in _timings(result).items():
             say(f"lsys: {k:<18} {v * 1000:9.1f} ms")

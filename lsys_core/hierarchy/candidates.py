@@ -60,6 +60,12 @@ class Candidate:
         Proximity, similarity and (relative) sequence length of the importance.
     start : float
         Mean input order of the applications' first elements (ties go to the drawing order).
+    slack : tuple of float
+        Per application, how much farther its elements may still move within the tolerance
+        once the rule places them (set when the candidate is accepted).
+    starts : tuple of complex pairs
+        Per application, the pose it starts from when that is not its first node's pose
+        (set when the candidate is accepted).
     """
 
     space: tuple[int, int]
@@ -68,6 +74,8 @@ class Candidate:
     phi: float
     l: float
     start: float = 0.0
+    slack: tuple[float, ...] = ()
+    starts: tuple[tuple[complex, complex], ...] = ()
 
     @property
     def covered(self) -> int:

@@ -204,26 +204,49 @@ def cluster_bounds(ledger: Ledger, labels: np.ndarray, src: np.ndarray, dst: np.
 
 def _pose_error(
     nodes: Nodes, idx: np.ndarray, a_pred: np.ndarray, b_pred: np.ndarray, sizes, period
-) -> float:
-    """Largest displacement (translation plus rotation/scale at the rim) of nodes from predicted poses."""
+) -> np.ndarray:
+    """Displacement (translation plus rotation/scale at the rim) of nodes from predicted poses."""
     sym = nodes.sym[idx]
     ratio = nodes.a[idx] / a_pred
     p = period[sym]
     ang = np.angle(ratio)
     ang = np.where(p > 0, ang - np.round(ang / np.where(p > 0, p, 1.0)) * p, ang)
     ratio = np.where(p < 0, np.abs(ratio), np.abs(ratio) * np.exp(1j * ang))
-    err = np.abs(b_pred - nodes.b[idx]) + np.abs(a_pred) * np.abs(ratio - 1.0) * sizes[sym]
-    return float(err.max()) if err.size else 0.0
+    return np.abs(b_pred - nodes.b[idx]) + np.abs(a_pred) * np.abs(ratio - 1.0) * sizes[sym]
 
 
-def _chain_poses(nodes: Nodes, groups, A: complex, B: complex):
+def _chain_poses(nodes: Nodes, groups, A: complex, B: complex, lever: np.ndarray):
+    """Poses the sequences ``P(m) -> X T P(m-1)`` derive, from the start that fits each group best.
+
+    The start of every application is the pose ``(a0, b0)`` minimising the squared
+    displacements (positions, and turns/scales at each node's ``lever``) of all its nodes, not
+    the first node's own pose: a jittered first element would otherwise tilt the whole row.
+    """
     idx = np.concatenate(groups)
-    first = np.concatenate([np.full(g.size, g[0]) for g in groups])
+    owner = np.repeat(np.arange(len(groups)), [g.size for g in groups])
     k = np.concatenate([np.arange(g.size) for g in groups]).astype(float)
-    Ak = A**k
-    steps = k if abs(A - 1) < 1e-12 else (Ak - 1.0) / (A - 1.0)
-    a0, b0 = nodes.a[first], nodes.b[first]
-    return idx, a0 * Ak, b0 + a0 * B * steps
+    u = A**k
+    v = B * (k if abs(A - 1) < 1e-12 else (u - 1.0) / (A - 1.0))
+    a, b, r2 = nodes.a[idx], nodes.b[idx], lever**2
+    n = len(groups)
+
+    def total(x: np.ndarray) -> np.ndarray:
+        return np.bincount(owner, x.real, n) + 1j * np.bincount(owner, x.imag, n)
+
+    p = np.bincount(owner, r2 * np.abs(u) ** 2 + np.abs(v) ** 2, n)
+    sv, count = total(v), np.bincount(owner, minlength=n)
+    rhs_a, rhs_b = total(r2 * np.conj(u) * a + np.conj(v) * b), total(b)
+    det = p * count - np.abs(sv) ** 2
+    ok = np.abs(det) > 1e-12 * np.maximum(p * count, 1e-300)
+    a0 = np.where(
+        ok,
+        (rhs_a * count - np.conj(sv) * rhs_b) / np.where(ok, det, 1.0),
+        nodes.a[idx[np.searchsorted(owner, np.arange(n))]],
+    )
+    b0 = np.where(
+        ok, (rhs_b - sv * a0) / np.maximum(count, 1), nodes.b[idx[np.searchsorted(owner, np.arange(n))]]
+    )
+    return idx, a0[owner] * u, b0[owner] + a0[owner] * v, (a0, b0)
 
 
 def _linear_poses(nodes: Nodes, c: LinearCandidate):
@@ -256,8 +279,10 @@ def _tree_poses(nodes: Nodes, c: BranchCandidate):
     return np.concatenate(idx), np.concatenate(pa), np.concatenate(pb)
 
 
-def placement_error(c: Candidate, nodes: Nodes, sizes: np.ndarray, period: np.ndarray) -> float:
-    """Largest distance between a node and where the candidate's rule would derive it.
+def placement_error(
+    c: Candidate, nodes: Nodes, sizes: np.ndarray, period: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray] | None, tuple[np.ndarray, np.ndarray]]:
+    """Distance between every node of ``c`` and where the candidate's rule would derive it.
 
     Parameters
     ----------
@@ -270,13 +295,25 @@ def placement_error(c: Candidate, nodes: Nodes, sizes: np.ndarray, period: np.nd
     period : ndarray
         Per symbol, the rotation (radians) that maps its shape onto itself: 0 for none,
         negative for any rotation (a circle).
+
+    Returns
+    -------
+    idx, err : ndarray
+        The nodes, group after group, and their distances (document units).
+    starts : tuple of ndarray, or None
+        For sequences and pairs, the pose ``(a0, b0)`` every application starts from (fitted
+        to all its nodes); None where the application starts at its first node.
+    derived : tuple of ndarray
+        The poses ``(a, b)`` the rule derives for the nodes.
     """
+    starts = None
     if isinstance(c, (SeqCandidate, PairCandidate)):
-        idx, pa, pb = _chain_poses(nodes, c.groups, c.A, c.B)
+        lever = sizes[nodes.sym[np.concatenate(c.groups)]]
+        idx, pa, pb, starts = _chain_poses(nodes, c.groups, c.A, c.B, lever)
     elif isinstance(c, LinearCandidate):
         idx, pa, pb = _linear_poses(nodes, c)
     elif isinstance(c, BranchCandidate):
         idx, pa, pb = _tree_poses(nodes, c)
     else:  # pragma: no cover
         raise TypeError(f"unknown candidate {type(c).__name__}")
-    return _pose_error(nodes, idx, pa, pb, sizes, period)
+    return idx, _pose_error(nodes, idx, pa, pb, sizes, period), starts, (pa, pb)

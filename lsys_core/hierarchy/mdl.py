@@ -39,6 +39,7 @@ from lsys_core.grammar.model import Case, Count, Grammar, Module, Pop, Push, Rul
 __all__ = [
     "Precision",
     "count_bits",
+    "flat_bits",
     "grammar_bits",
     "log2_binom",
     "placement_set_bits",
@@ -83,14 +84,19 @@ class Precision:
     area: float
 
     @classmethod
-    def of_circles(cls, center: np.ndarray, radius: np.ndarray, eps: float) -> Precision:
-        """The precision for a drawing given as bounding circles of its elements."""
-        lo_x, hi_x = np.min(center.real - radius), np.max(center.real + radius)
-        lo_y, hi_y = np.min(center.imag - radius), np.max(center.imag + radius)
-        w, h = float(hi_x - lo_x), float(hi_y - lo_y)
+    def of_box(cls, lo: complex, hi: complex, eps: float) -> Precision:
+        """The precision for a drawing whose bounding box has corners ``lo`` and ``hi``."""
+        w, h = float(hi.real - lo.real), float(hi.imag - lo.imag)
         diag = max(math.hypot(w, h), 1e-12)
         eps = min(max(float(eps), 1e-9 * diag), diag)
         return cls(eps, diag, max(w, eps) * max(h, eps))
+
+    @classmethod
+    def of_circles(cls, center: np.ndarray, radius: np.ndarray, eps: float) -> Precision:
+        """The precision for a drawing given as bounding circles of its elements."""
+        lo = complex(np.min(center.real - radius), np.min(center.imag - radius))
+        hi = complex(np.max(center.real + radius), np.max(center.imag + radius))
+        return cls.of_box(lo, hi, eps)
 
     def relaxed(self, eps: float) -> Precision:
         """The same drawing at another tolerance."""
@@ -419,6 +425,18 @@ def _set_code(
             prec, len(group), occupied=stacks.size, pose=pose, counts=counts, token=token
         )
     return bits
+
+
+def flat_bits(prec: Precision, n_segments: np.ndarray, radius: np.ndarray) -> float:
+    """Bits of a drawing as given: every element its own shape, placed one by one.
+
+    The reference the inferred grammar is measured against: each element's shape
+    (:func:`shape_bits`) and its place, as one placement set per shape.
+    """
+    n = int(np.size(n_segments))
+    token = token_bits(n + 1)
+    per = token + float(log2_binom(prec.cells, 1.0))
+    return float(np.sum(shape_bits(prec, n_segments, radius))) + n * per + OP_BITS
 
 
 def grammar_bits(g: Grammar, prec: Precision, *, shapes: bool = True) -> float:

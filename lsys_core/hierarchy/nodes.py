@@ -32,6 +32,9 @@ class Nodes:
         Radius of that geometry about ``center``.
     members : tuple of ndarray of int
         Input elements covered by every node.
+    slack : ndarray of float, shape (n,)
+        How far every node may still move: the tolerance less what its elements already
+        deviate (their shapes, and the rules that placed them).
     """
 
     sym: np.ndarray
@@ -40,10 +43,17 @@ class Nodes:
     center: np.ndarray
     radius: np.ndarray
     members: tuple[np.ndarray, ...]
+    slack: np.ndarray
 
     @classmethod
     def of_elements(
-        cls, group: np.ndarray, a: np.ndarray, b: np.ndarray, center: np.ndarray, radius: np.ndarray
+        cls,
+        group: np.ndarray,
+        a: np.ndarray,
+        b: np.ndarray,
+        center: np.ndarray,
+        radius: np.ndarray,
+        slack: np.ndarray | float = np.inf,
     ) -> Nodes:
         """Return the first level's nodes: one per input element (copies of the given arrays)."""
         n = np.asarray(a).size
@@ -54,6 +64,7 @@ class Nodes:
             np.asarray(center, complex).copy(),
             np.asarray(radius, float).copy(),
             tuple(np.array([i]) for i in range(n)),
+            np.broadcast_to(np.asarray(slack, float), (n,)).copy(),
         )
 
     def __len__(self) -> int:
@@ -63,7 +74,13 @@ class Nodes:
         """Return the smallest input element index each node covers (the order it was drawn in)."""
         return np.array([int(m.min()) for m in self.members], dtype=np.int64)
 
-    def merge(self, groups: list[np.ndarray], syms: list[int]) -> tuple[Nodes, np.ndarray]:
+    def merge(
+        self,
+        groups: list[np.ndarray],
+        syms: list[int],
+        slack: list[float] | None = None,
+        starts: tuple[tuple[complex, complex], ...] | None = None,
+    ) -> tuple[Nodes, np.ndarray]:
         """Replace every group of nodes by one node of symbol ``syms[k]`` at its first node's pose.
 
         Parameters
@@ -72,6 +89,10 @@ class Nodes:
             Disjoint groups of node indices, each with its first node first.
         syms : list of int
             The new node's symbol for every group.
+        slack : list of float, optional
+            The new node's slack for every group (default: the smallest of its nodes').
+        starts : tuple of (a, b), optional
+            The new node's pose for every group (default: its first node's).
 
         Returns
         -------
@@ -96,14 +117,20 @@ class Nodes:
         np.maximum.at(rad, owner, np.abs(self.center[flat] - cen[owner]) + self.radius[flat])
         first = np.array([int(g[0]) for g in groups], dtype=np.int64)
         kept = np.flatnonzero(keep)
+        if slack is None:
+            new_slack = np.full(len(groups), np.inf)
+            np.minimum.at(new_slack, owner, self.slack[flat])
+        else:
+            new_slack = np.asarray(slack, float)
         nodes = Nodes(
             np.concatenate([self.sym[kept], np.asarray(syms, np.int64)]),
-            np.concatenate([self.a[kept], self.a[first]]),
-            np.concatenate([self.b[kept], self.b[first]]),
+            np.concatenate([self.a[kept], self.a[first] if starts is None else [p[0] for p in starts]]),
+            np.concatenate([self.b[kept], self.b[first] if starts is None else [p[1] for p in starts]]),
             np.concatenate([self.center[kept], cen]),
             np.concatenate([self.radius[kept], rad]),
             tuple(self.members[i] for i in kept)
             + tuple(np.concatenate([self.members[i] for i in g]) for g in groups),
+            np.concatenate([self.slack[kept], new_slack]),
         )
         mapping = np.full(n, -1)
         mapping[kept] = np.arange(kept.size)

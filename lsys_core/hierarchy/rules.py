@@ -32,7 +32,7 @@ from lsys_core.hierarchy.emit import const_t, const_t_many, emit
 from lsys_core.hierarchy.gain import Ledger, placement_error
 from lsys_core.hierarchy.mdl import Precision
 from lsys_core.hierarchy.nodes import Nodes
-from lsys_core.hierarchy.snap import snapped
+from lsys_core.hierarchy.snap import SHARE, snapped
 from lsys_core.hierarchy.spaces import pair_space
 from lsys_core.hierarchy.symbols import SymbolTable
 from lsys_core.settings import setting
@@ -41,6 +41,8 @@ __all__ = ["Hierarchy", "Tolerance", "Weights", "build_hierarchy"]
 
 #: Levels of the hierarchy at most (each level codes at least one repetition).
 MAX_LEVELS = 100
+#: ``measure(elements, a, b)``: how far input elements would be from their terminals drawn at poses ``a, b``.
+Measure = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 #: Default tolerance, as a share of the drawing's diagonal, when none is given.
 DEFAULT_TOLERANCE = 0.005
 #: A best candidate covering less than this share of the nodes is applied together with all
@@ -130,6 +132,10 @@ def build_hierarchy(
     tol: Tolerance = Tolerance(),
     similarity: np.ndarray | None = None,
     precision: Precision | None = None,
+    tolerance: float | None = None,
+    slack: np.ndarray | None = None,
+    snap: float = SHARE,
+    measure: Measure | None = None,
     symmetry: np.ndarray | None = None,
     neighbours: int = 24,
     cancel: CancelToken | None = None,
@@ -155,6 +161,18 @@ def build_hierarchy(
         The tolerance and the drawing's size: a rule is written only when it shortens the
         description (:mod:`lsys_core.hierarchy.mdl`) and derives every node it explains within
         the tolerance.  Default: :data:`DEFAULT_TOLERANCE` of the drawing's diagonal.
+    tolerance
+        How far (document units) the derived drawing may deviate from the input (default:
+        the precision's ``eps``; :func:`~lsys_core.pipeline.symmetrize` allows more, while the
+        description length stays measured at the user's precision).
+    slack
+        How far every element may be moved by the rules (default: the tolerance); the
+        pipeline passes the tolerance less each element's shape deviation.
+    snap
+        Share of the tolerance the rounding of a rule's numbers may spend.
+    measure
+        ``measure(elements, a, b)``: the deviation of input elements from their terminals
+        drawn at poses ``a, b`` (document units), to check single elements exactly.
     symmetry
         Rotational symmetry order of every terminal (1: none, k: k-fold, 0: continuous), so
         rotations that do not show are not counted as deviations.
@@ -173,11 +191,12 @@ def build_hierarchy(
     table = SymbolTable(terminal_names, terminal_sizes, sim)
     ctx = _Context(table, tol)
     book = _Book(np.asarray(a).size)
-    nodes = Nodes.of_elements(group, a, b, center, radius)
     prec = precision
     if prec is None:
-        prec = Precision.of_circles(nodes.center, nodes.radius, 0.0)
-        prec = Precision.of_circles(nodes.center, nodes.radius, DEFAULT_TOLERANCE * prec.diagonal)
+        prec = Precision.of_circles(np.asarray(center), np.asarray(radius), 0.0)
+        prec = Precision.of_circles(np.asarray(center), np.asarray(radius), DEFAULT_TOLERANCE * prec.diagonal)
+    limit = prec.eps if tolerance is None else float(tolerance)
+    nodes = Nodes.of_elements(group, a, b, center, radius, limit if slack is None else slack)
     order = np.ones(nt, int) if symmetry is None else np.asarray(symmetry, int)
     term_period = np.where(order == 0, -1.0, np.where(order >= 2, 2 * np.pi / np.maximum(order, 1), 0.0))
     n0 = len(nodes)
@@ -210,7 +229,17 @@ def build_hierarchy(
         if cands and level < MAX_LEVELS:
             first = nodes.first_members()
             cands = [replace(c, start=float(np.mean([first[g[0]] for g in c.groups]))) for c in cands]
-            test = partial(_worthwhile, ledger=ledger, nodes=nodes, sizes=table.sizes, period=period)
+            test = partial(
+                _worthwhile,
+                ledger=ledger,
+                nodes=nodes,
+                sizes=table.sizes,
+                period=period,
+                snap=snap,
+                measure=measure,
+                n_terminals=nt,
+                limit=limit,
+            )
             chosen = _choose(cands, weights, len(nodes), test)
         if chosen:
             level += 1
@@ -283,19 +312,44 @@ def _duplicates(table: SymbolTable, nodes: Nodes) -> list[Candidate]:
 
 
 def _worthwhile(
-    c: Candidate, ledger: Ledger, nodes: Nodes, sizes: np.ndarray, period: np.ndarray
+    c: Candidate,
+    ledger: Ledger,
+    nodes: Nodes,
+    sizes: np.ndarray,
+    period: np.ndarray,
+    snap: float,
+    measure: Measure | None = None,
+    n_terminals: int = 0,
+    limit: float = np.inf,
 ) -> Candidate | None:
     """The candidate with its numbers rounded, if it shortens the description within the tolerance.
 
     This is the minimum description length test (:mod:`lsys_core.hierarchy.mdl`): a transform
     that repeats by chance among unrelated elements does not pay for its rule.  Its numbers
     are rounded first (:func:`~lsys_core.hierarchy.snap.snapped`), and the rule, derived from
-    each application's first node, must put every node within the tolerance.
+    each application's first node, must put every node within its slack (what is left of the
+    tolerance once its shapes and earlier rules have used their part).  Where that bound is
+    too coarse for single elements (hand-drawn copies: shape and pose noise add up on paper,
+    not on the page), ``measure`` tells how far the derived element really is.
     """
-    c = snapped(c, nodes, ledger.prec.eps)
-    if placement_error(c, nodes, sizes, period) > ledger.prec.eps or ledger.gain(c) <= 0.0:
+    c = snapped(c, nodes, limit, snap)
+    idx, err, starts, (pa, pb) = placement_error(c, nodes, sizes, period)
+    left = nodes.slack[idx] - err
+    over = np.flatnonzero(left < 0.0)
+    if over.size and measure is not None:
+        single = np.array([nodes.members[i].size == 1 for i in idx[over]]) & (
+            nodes.sym[idx[over]] < n_terminals
+        )
+        if single.all():
+            elements = np.array([int(nodes.members[i][0]) for i in idx[over]])
+            left[over] = limit - measure(elements, pa[over], pb[over])
+    if (left < 0.0).any() or ledger.gain(c) <= 0.0:
         return None
-    return c
+    owner = np.repeat(np.arange(len(c.groups)), [g.size for g in c.groups])
+    slack = np.full(len(c.groups), np.inf)
+    np.minimum.at(slack, owner, left)
+    poses = () if starts is None else tuple(zip(starts[0].tolist(), starts[1].tolist(), strict=True))
+    return replace(c, slack=tuple(float(v) for v in slack), starts=poses)
 
 
 def _scores(cands: list[Candidate], w: Weights) -> np.ndarray:
@@ -348,7 +402,9 @@ def _apply_all(table: SymbolTable, book: _Book, chosen: list[Candidate], nodes: 
     for k, cand in enumerate(chosen):
         out = emit(table, cand)
         book.add(out.rule, out.log, [np.concatenate([nodes.members[i] for i in g]) for g in out.groups])
-        nodes, mapping = nodes.merge(list(out.groups), list(out.syms))
+        nodes, mapping = nodes.merge(
+            list(out.groups), list(out.syms), list(cand.slack) or None, cand.starts or None
+        )
         new = np.arange(len(nodes) - len(out.groups), len(nodes))
         for sid, i in zip(out.syms, new, strict=True):
             table.set_size(sid, float(nodes.radius[i] / abs(nodes.a[i])))

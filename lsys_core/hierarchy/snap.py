@@ -26,32 +26,31 @@ from lsys_core.hierarchy.emit import nice
 from lsys_core.hierarchy.gain import group_reach
 from lsys_core.hierarchy.nodes import Nodes
 
-__all__ = ["snapped"]
+__all__ = ["SHARE", "snapped"]
 
-#: Share of the tolerance the rounding of one candidate may spend.
-_SHARE = 0.1
+#: Share of the tolerance the rounding of one candidate may spend (:func:`symmetrize
+#: <lsys_core.pipeline.symmetrize>`, whose purpose is regularity, lets it spend more).
+SHARE = 0.1
 
 
 def _snap_transform(
     A: complex, B: complex, length: float, angle: float, scale: float
 ) -> tuple[complex, complex]:
     al, d, s, be = (float(v) for v in t4_from_rel(A, B))
-    if d <= length:
-        be, al, d = be + al, 0.0, 0.0
-    al = nice(al, abs_tol=angle)
-    be = nice(float((be + 180.0) % 360.0 - 180.0), abs_tol=angle)
-    d = nice(d, abs_tol=length)
+    turn = nice(float((al + be + 180.0) % 360.0 - 180.0), abs_tol=angle)  # the shape's own turn first
+    al = 0.0 if d <= length else nice(al, abs_tol=angle)
+    d = 0.0 if d <= length else nice(d, abs_tol=length)
     s = nice(s, abs_tol=scale)
-    A2, B2 = rel_from_t4(al, d, s, be)
+    A2, B2 = rel_from_t4(al, d, s, turn - al)
     return complex(A2), complex(B2)
 
 
-def snapped(c: Candidate, nodes: Nodes, eps: float) -> Candidate:
-    """Return ``c`` with its numbers rounded within the tolerance ``eps`` (see the module docstring)."""
+def snapped(c: Candidate, nodes: Nodes, eps: float, share: float = SHARE) -> Candidate:
+    """Return ``c`` with its numbers rounded within ``share`` of the tolerance ``eps`` (see the module docstring)."""
     steps = max(max(int(g.size) for g in c.groups) - 1, 1)
     if isinstance(c, BranchCandidate):
         steps = max(c.depths) + 1
-    budget = _SHARE * eps / steps
+    budget = share * eps / steps
     reach = max(float(group_reach(nodes, c.groups).max()), 1e-12)
     length = budget
     angle = math.degrees(budget / reach)

@@ -1,12 +1,12 @@
-"""Keep every element's shape: split off elements their terminal does not reproduce.
+"""Keep every element's shape within the tolerance of the terminal drawn in its place.
 
 The similarity φ of §4.1 measures how much of two outlines overlap, so at the paper's
 threshold 0.6 a bar of height 140 joins a group of bars of height 120.  Drawing the
-group's representative in its place would change the art.  Here every element is
-compared with its posed terminal (largest distance from the element's samples to the
-terminal's outline, and the outline lengths); elements that deviate by more than a
-tolerance tied to the similarity threshold are grouped again among themselves, so
-repeated variants still share a terminal of their own.
+group's representative in its place would change the art.  Here every element is compared
+with its posed terminal (the symmetric outline distance of
+:mod:`lsys_core.instancing.deviation`); elements farther than the tolerance — a length in
+document units, the user's — are grouped again among themselves, so repeated variants still
+share a terminal of their own, and near-identical (hand-drawn) copies within it share one.
 """
 
 from __future__ import annotations
@@ -14,58 +14,33 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from scipy.spatial import cKDTree
 
-from lsys_core.cancel import CancelToken
+from lsys_core.cancel import CancelToken, check
+from lsys_core.instancing.deviation import pose_deviations
 from lsys_core.instancing.model import Instancing
 from lsys_core.svg.model import Element, Scene
 
-__all__ = ["deviation_tolerance", "split_unfaithful"]
+__all__ = ["deviations", "split_unfaithful"]
 
 
-def deviation_tolerance(threshold: float) -> float:
-    """Allowed deviation, as a fraction of the element's radius, for a similarity threshold."""
-    return 0.05 * (1.0 - threshold) + 0.002
-
-
-def _deviations(
-    scene: Scene, inst: Instancing, radius: np.ndarray, tol: float, absolute: float
-) -> np.ndarray:
-    """Deviation of every element from its posed terminal, in units of its allowance (> 1: too far)."""
+def deviations(scene: Scene, inst: Instancing, *, exact: float = 0.0) -> np.ndarray:
+    """Distance of every element from its terminal drawn at its pose (document units)."""
     from lsys_core.geometry.shapes import shape_arrays
-    from lsys_core.instancing.sampling import arc_fractions, sample_elements
 
-    els = sample_elements(scene.elements, arc_fractions(48))
-    terms = tuple(Element(*shape_arrays(t.path)) for t in inst.terminals)
-    reps = sample_elements(terms, arc_fractions(512))
-    dev = np.zeros(len(scene.elements))
-    for g in range(len(inst.terminals)):
-        idx = np.flatnonzero(inst.group == g)
-        if idx.size == 0:
-            continue
-        rep = reps.points[g]
-        tree = cKDTree(np.column_stack([rep.real, rep.imag]))
-        local = (els.points[idx] - inst.b[idx, None]) / inst.a[idx, None]
-        d, _ = tree.query(np.column_stack([local.real.ravel(), local.imag.ravel()]))
-        far = d.reshape(idx.size, -1).max(axis=1) * np.abs(inst.a[idx])
-        length_rep = reps.length[g] * np.abs(inst.a[idx])
-        rel_len = np.abs(els.length[idx] - length_rep) / np.maximum(length_rep, 1e-300)
-        allowed = np.minimum(tol * radius[idx], absolute)
-        dev[idx] = np.maximum(far / np.maximum(allowed, 1e-300), rel_len / tol)
-    return dev
+    shapes = [Element(*shape_arrays(t.path)) for t in inst.terminals]
+    return pose_deviations(scene.elements, shapes, inst.group, inst.a, inst.b, exact=exact)
 
 
 def split_unfaithful(
     scene: Scene,
     inst: Instancing,
-    radius: np.ndarray,
     *,
+    tolerance: float,
     threshold: float = 0.6,
-    absolute: float = np.inf,
     cancel: CancelToken | None = None,
     rounds: int = 3,
 ) -> Instancing:
-    """Return ``inst`` with elements that deviate from their terminal moved to new terminals.
+    """Return ``inst`` with elements farther than ``tolerance`` from their terminal moved to new terminals.
 
     Parameters
     ----------
@@ -73,29 +48,34 @@ def split_unfaithful(
         The imported elements.
     inst : Instancing
         Result of :func:`~lsys_core.instancing.similarity.detect_similarity` on ``scene``.
-    radius : ndarray
-        Radius of every element (its size for the relative deviation).
+    tolerance : float
+        Largest deviation of an element from its posed terminal, in document units.
     threshold : float
-        The similarity threshold used; lower thresholds tolerate larger deviations.
-    absolute : float
-        Largest deviation in document units, whatever the element's size.
+        The similarity threshold used to group the deviating elements again.
     rounds : int
         Regrouping rounds; what still deviates afterwards becomes a terminal of its own.
+
+    Returns
+    -------
+    Instancing
+        With :attr:`~lsys_core.instancing.model.Instancing.deviation` filled in.
     """
     from lsys_core.instancing.similarity import detect_similarity, terminal_name
 
-    tol = deviation_tolerance(threshold)
+    exact = 1e-3 * tolerance
     for r in range(rounds + 1):
-        bad = np.flatnonzero(_deviations(scene, inst, radius, tol, absolute) > 1.0)
+        check(cancel)
+        dev = deviations(scene, inst, exact=exact)
+        bad = np.flatnonzero(dev > tolerance)
         if bad.size == 0:
-            return inst
+            return replace(inst, deviation=dev)
         sub = Scene(tuple(scene.elements[i] for i in bad), scene.viewbox, scene.size)
         if r < rounds:
             part = detect_similarity(sub, threshold=threshold, cancel=cancel)
         else:
             part = _singletons(sub)
         inst = _merge(inst, bad, part, terminal_name)
-    return inst
+    return replace(inst, deviation=deviations(scene, inst, exact=exact))
 
 
 def _singletons(sub: Scene) -> Instancing:

@@ -29,6 +29,9 @@ class Instancing:
         0: continuous, e.g. a circle), so inference may choose among equivalent poses.
     mirrored_of : ndarray of int, shape (groups,)
         For a terminal that is the mirror image of another, that group's index; else -1.
+    deviation : ndarray of float, shape (n,), optional
+        Distance of every element from its terminal drawn at its pose (document units), once
+        measured (:func:`~lsys_core.instancing.fidelity.split_unfaithful`).
     """
 
     group: np.ndarray
@@ -37,3 +40,4 @@ class Instancing:
     terminals: tuple[Terminal, ...]
     symmetry: np.ndarray
     mirrored_of: np.ndarray
+    deviation: np.ndarray | None = None

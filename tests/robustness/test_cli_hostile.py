@@ -336,7 +336,8 @@ def test_hostile_cli_run(case: Case, runs) -> None:
     assert noise == [], f"stray output on stderr: {noise[:3]}"
     errors = [line for line in lines if line.startswith("lsys: error: ")]
     warnings = [line for line in lines if line.startswith("lsys: warning: ")]
-    assert len(errors) + len(warnings) == len(lines)
+    summaries = [line for line in lines if line.startswith("lsys: inferred ")]
+    assert len(errors) + len(warnings) + len(summaries) == len(lines)
     if case.error is not None:
         assert res.returncode == 1, res.stderr
         assert len(errors) == 1 and lines[-1] == errors[0], res.stderr
