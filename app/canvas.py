@@ -252,6 +252,9 @@ class Canvas(QWidget):
         self._highlight: np.ndarray | None = None
         self._highlight_rule: int | None = None
         self._highlight_terminal: int | None = None
+        #: Draws over the frame and may take mouse presses first (the handles).
+        self.overlay: Any = None
+        self._overlay_drag = False
         self.runner = LatestRunner(
             render_frame, name="lsys-render", prepare=self._assign_surface, parent=self
         )
@@ -500,6 +503,9 @@ class Canvas(QWidget):
                     QTransform(s, 0, 0, s, self.view.ox - f.view.ox * s, self.view.oy - f.view.oy * s)
                 )
                 painter.drawImage(QPointF(0, 0), f.image)
+        if self.overlay is not None:
+            painter.resetTransform()
+            self.overlay.paint(painter)
         painter.end()
 
     def resizeEvent(self, event) -> None:
@@ -539,7 +545,15 @@ class Canvas(QWidget):
             super().keyReleaseEvent(event)
 
     def mousePressEvent(self, event) -> None:
-        """Start a pan (any drag) or a click."""
+        """Start a handle drag, a pan (any drag) or a click."""
+        if (
+            self.overlay is not None
+            and event.button() == Qt.MouseButton.LeftButton
+            and not self._space
+            and self.overlay.press(event.position())
+        ):
+            self._overlay_drag = True
+            return
         self._press_pos = event.position()
         self._drag_start = event.position()
         self._drag_view = self.view
@@ -547,7 +561,10 @@ class Canvas(QWidget):
             self.setCursor(Qt.CursorShape.ClosedHandCursor)
 
     def mouseMoveEvent(self, event) -> None:
-        """Pan while dragging."""
+        """Drag a handle, or pan."""
+        if self._overlay_drag:
+            self.overlay.move(event.position())
+            return
         if self._drag_start is None or self._drag_view is None:
             return
         delta = event.position() - self._drag_start
@@ -561,6 +578,10 @@ class Canvas(QWidget):
 
     def mouseReleaseEvent(self, event) -> None:
         """A release without movement is a click: pick the element under it."""
+        if self._overlay_drag:
+            self._overlay_drag = False
+            self.overlay.release(event.position())
+            return
         if self._press_pos is not None and event.button() == Qt.MouseButton.LeftButton and not self._space:
             self.elementClicked.emit(self.pick(event.position()))
         self._drag_start = self._drag_view = self._press_pos = None

@@ -19,7 +19,9 @@ __all__ = [
     "drawing_bounds",
     "export_png",
     "export_svg",
+    "find_handles",
     "format_grammar",
+    "handle_values",
     "infer",
     "instance_centers",
     "instance_radius",
@@ -133,6 +135,20 @@ def rules_under(grammar: Any, name: str) -> set[str]:
     from lsys_core.grammar.semantics import rules_under as _under
 
     return _under(grammar, name)
+
+
+def find_handles(grammar: Any, drawing: Any, index: int, knob: float) -> Any:
+    """Return the handles of the repetition of instance ``index`` (``lsys_core.derive.handles``)."""
+    from lsys_core.derive.handles import find_handles as _find
+
+    return _find(grammar, drawing, index, knob)
+
+
+def handle_values(handles: Any, which: str, point: complex) -> dict[str, float]:
+    """Return control values for handle ``which`` dragged to ``point`` (``drag_values``)."""
+    from lsys_core.derive.handles import drag_values
+
+    return drag_values(handles, which, point)
 
 
 def snap(value: float, tolerance: float, kind: str, *, ring: int | None = None) -> float:

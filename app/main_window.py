@@ -26,6 +26,7 @@ from .actions import create_actions, create_menus, redo_keys, undo_keys
 from .canvas import Canvas, legend
 from .dialogs import RandomizeDialog, ReplaceDialog
 from .document import Document
+from .handles import HandleEditor, HandleOverlay
 from .inference_panel import InferencePanel
 from .message_bar import MessageBar
 from .params_panel import ParamsPanel
@@ -72,6 +73,7 @@ class MainWindow(WindowFiles, QMainWindow):
         self.resize(1400, 900)
 
         self.canvas = Canvas(self)
+        self.canvas.overlay = self.handles = HandleOverlay(self.canvas)
         self.message_bar = MessageBar(self)
         central = QWidget(self)
         lay = QVBoxLayout(central)
@@ -177,6 +179,7 @@ class MainWindow(WindowFiles, QMainWindow):
         self.rules_view.dragStarted.connect(d.begin_gesture)
         self.rules_view.dragFinished.connect(d.end_gesture)
         self.rules_view.ruleSelected.connect(self.select_rule)
+        self.handle_editor = HandleEditor(d, self.handles, self.rules_view.control)
         self.structure_panel.ruleSelected.connect(self.select_rule)
         self.structure_panel.terminalSelected.connect(self.highlight_terminal)
         self.structure_panel.replaceRequested.connect(self.replace_dialog)
@@ -288,10 +291,12 @@ class MainWindow(WindowFiles, QMainWindow):
         drawing, grammar = self.doc.drawing, self.doc.grammar
         if drawing is None or grammar is None or index < 0:
             self.select_rule(None)
+            self.handles.select(None, grammar, drawing)
             return
         rule = int(drawing.rule[index])
         name = "axiom" if rule < 0 or rule >= len(grammar.rules) else grammar.rules[rule].name
         self.select_rule(name)
+        self.handles.select(index, grammar, drawing)
         self.statusBar().showMessage(f"element {index} drawn by {name}", 5000)
 
     def _update_actions(self, *_args: Any) -> None:

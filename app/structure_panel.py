@@ -72,6 +72,8 @@ class StructurePanel(QWidget):
         super().__init__(parent)
         self.grammar: Any = None
         self._items: dict[str, list[QTreeWidgetItem]] = {}
+        self._tree_key: tuple = ()
+        self._palette_key: tuple = ()
         self._updating = False
         self.tree = QTreeWidget(self)
         self.tree.setHeaderLabels(["Rule", "Draws", "Instances"])
@@ -134,8 +136,20 @@ class StructurePanel(QWidget):
         term_selected = self.selected_terminal()
         self._updating = True
         try:
-            self._fill_tree(grammar, {c.owner: c for c in cards})
-            self._fill_palette(grammar)
+            by_owner = {c.owner: c for c in cards}
+            tree_key = tuple((c.owner, c.terminals, c.calls) for c in cards)
+            if tree_key != self._tree_key:  # the structure changed: rebuild (else only the words)
+                self._tree_key = tree_key
+                self._fill_tree(grammar, by_owner)
+            else:
+                for name, items in self._items.items():
+                    card = by_owner.get(name)
+                    for item in items:
+                        item.setText(1, card.summary.split(": ", 1)[-1] if card else "")
+            palette_key = tuple((t.name, t.path, t.style) for t in grammar.terminals)
+            if palette_key != self._palette_key:
+                self._palette_key = palette_key
+                self._fill_palette(grammar)
             self.set_drawing(drawing)
             if selected:
                 self.select_rule(selected)

@@ -117,3 +117,17 @@ def wait_idle(qtbot):
         qtbot.waitUntil(win.is_idle, timeout=timeout)
 
     return wait
+
+
+@pytest.fixture
+def open_rules(window, tmp_path, wait_idle):
+    """Return ``open_rules(text)``: write ``text`` to an .lsys file, open it in the window, wait."""
+
+    def open_(text: str, name: str = "rules.lsys"):
+        path = tmp_path / name
+        path.write_text(text, encoding="utf-8")
+        window.open_path(str(path))
+        wait_idle(window)
+        return window
+
+    return open_

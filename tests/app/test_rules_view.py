@@ -18,12 +18,8 @@ Q(m): m == 0 -> P(11)
 
 
 @pytest.fixture
-def grid(window, tmp_path, wait_idle):
-    path = tmp_path / "grid.lsys"
-    path.write_text(GRID, encoding="utf-8")
-    window.open_path(str(path))
-    wait_idle(window)
-    return window
+def grid(open_rules):
+    return open_rules(GRID)
 
 
 def _control_row(window, owner: str, label: str):

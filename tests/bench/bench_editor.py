@@ -14,6 +14,8 @@ Reports, in milliseconds:
 * the longest UI-thread stall while inference of a 1,200-element scene runs in the background,
   with inference in a worker thread and in a worker process: a 2 ms QTimer on the UI thread
   records the gaps between its ticks (a stall is a gap minus the 2 ms period).
+* handle drag at 10,000 elements: a pointer move on the next-repetition handle → the draft
+  frame of the new step on screen (target ≤ 16 ms), timed like the slider moves.
 * weight change → new rules shown, for 300 and 1,200 elements (target ≤ 300 ms at 1,200): from
   typing a new weight into the inference panel to the new rules in the text, the panels and a
   full-quality frame on the canvas (inference in the editor's worker process).
@@ -105,17 +107,23 @@ def frame_ready(win) -> bool:
     )
 
 
-def bench_slider(app, workdir: Path, rows: int, cols: int, moves: int) -> dict:
-    """Time slider moves while dragging (drafts) and the full-quality frame after release."""
-    path = workdir / f"grid-{rows}x{cols}.lsys"
-    path.write_text(grid_grammar(rows, cols), encoding="utf-8")
+def open_grid(app, workdir: Path, rows: int, cols: int):
+    """Return a window showing the ``rows`` × ``cols`` grid grammar (no inference process)."""
     from app.jobs import run_inference
 
+    path = workdir / f"grid-{rows}x{cols}.lsys"
+    path.write_text(grid_grammar(rows, cols), encoding="utf-8")
     # No inference here: without a worker process, no process start-up (imports) competes with
     # the timed frames for the two cores.
     win = make_window(infer_compute=run_inference)
     win.open_path(str(path))
     wait_until(app, win.is_idle)
+    return win
+
+
+def bench_slider(app, workdir: Path, rows: int, cols: int, moves: int) -> dict:
+    """Time slider moves while dragging (drafts) and the full-quality frame after release."""
+    win = open_grid(app, workdir, rows, cols)
     n = len(win.doc.drawing)
     row = win.params_panel.rows["P.0.2.v"]  # the +(0.2) bend of every row
     drag, derive_ms, render_ms, full = [], [], [], []
@@ -203,6 +211,53 @@ def bench_stall(app, workdir: Path, in_process: bool, seconds: float) -> dict:
         "p99_stall_ms": sorted(gaps)[int(0.99 * (len(gaps) - 1))] if gaps else float("nan"),
         "ticks": len(ticks),
         "cancel_s": round(cancel_s, 3),
+    }
+
+
+def bench_handle_drag(app, workdir: Path, rows: int, cols: int, moves: int) -> dict:
+    """Time drags of the next-repetition handle: pointer move → draft frame on screen."""
+    from PySide6.QtCore import QEvent, QPointF, Qt
+    from PySide6.QtGui import QMouseEvent
+    from PySide6.QtWidgets import QApplication
+
+    win = open_grid(app, workdir, rows, cols)
+    canvas = win.canvas
+    win.canvas.elementClicked.emit(0)
+    h = win.handles.handles
+    x, y = canvas.view.to_widget(h.b1.real, h.b1.imag)
+    start = QPointF(x, y)
+
+    def send(kind, pos: QPointF, buttons) -> None:
+        button = Qt.MouseButton.LeftButton if kind != QEvent.Type.MouseMove else Qt.MouseButton.NoButton
+        event = QMouseEvent(
+            kind, pos, canvas.mapToGlobal(pos), button, buttons, Qt.KeyboardModifier.NoModifier
+        )
+        QApplication.sendEvent(canvas, event)
+
+    times = []
+    for gesture in range(3):
+        send(QEvent.Type.MouseButtonPress, start, Qt.MouseButton.LeftButton)
+        for k in range(1, moves + 1):
+            t0 = time.perf_counter()
+            send(QEvent.Type.MouseMove, start + QPointF(0.0, 0.7 * k), Qt.MouseButton.LeftButton)
+            wait_until(app, lambda: frame_ready(win), signals=(canvas.runner.resultReady,))
+            canvas.repaint()
+            if gesture:
+                times.append((time.perf_counter() - t0) * 1e3)
+            assert canvas._frame.draft
+        send(QEvent.Type.MouseButtonRelease, start + QPointF(0.0, 0.7 * moves), Qt.MouseButton.NoButton)
+        wait_until(app, win.is_idle)
+        win.doc.undo_stack.undo()
+        wait_until(app, win.is_idle)
+    n = len(win.doc.drawing)
+    steps = win.doc.undo_stack.count()
+    win.doc.undo_stack.setClean()
+    win.close()
+    return {
+        "elements": n,
+        "median_ms": statistics.median(times),
+        "p90_ms": sorted(times)[int(0.9 * (len(times) - 1))],
+        "undo_steps_left": steps,
     }
 
 
@@ -300,7 +355,9 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="fewer moves and a shorter inference window")
     parser.add_argument("--stall-seconds", type=float, default=20.0, help="longest inference observed")
     parser.add_argument(
-        "--only", default="slider,stall,reweight,apply", help="comma-separated parts to run (default: all)"
+        "--only",
+        default="slider,stall,reweight,apply,handles",
+        help="comma-separated parts to run (default: all)",
     )
     args = parser.parse_args(argv)
     parts = set(args.only.split(","))
@@ -346,6 +403,13 @@ def main(argv=None) -> int:
             print(
                 f"applying rules with {r['params']} parameters: longest UI stall {r['max_stall_ms']:.1f} ms "
                 f"(UI-thread CPU in it {r['ui_cpu_in_it_ms']:.1f} ms; target ≤ 50)",
+                flush=True,
+            )
+        for r in [bench_handle_drag(app, work, 100, 100, moves)] if "handles" in parts else []:
+            out["handles"] = r
+            print(
+                f"handle drag at {r['elements']:,} elements: pointer move → draft frame {r['median_ms']:.1f} ms "
+                f"median, p90 {r['p90_ms']:.1f} ms (target ≤ 16)",
                 flush=True,
             )
     if args.json:

@@ -1,0 +1,109 @@
+"""Handles on the canvas: select an instance, drag its repetition's step, turn, scale; +/− count."""
+
+from __future__ import annotations
+
+import cmath
+import math
+
+import pytest
+from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
+from PySide6.QtGui import QMouseEvent
+from PySide6.QtTest import QTest
+from PySide6.QtWidgets import QApplication
+
+HELIX = """lsys 1
+terminal A "M 0 0 L 8 0 L 8 3 Z" style "fill:#2a6"
+axiom: +(20) f(300) +(-20) P(40)
+P(m): m > 0 -> A +(-80) f(-24) *(0.99) +(91) P(m-1)
+P(m): m == 0 -> A
+"""
+
+
+@pytest.fixture
+def helix(open_rules):
+    window = open_rules(HELIX)
+    window.canvas.elementClicked.emit(5)
+    assert window.handles.handles is not None
+    return window
+
+
+def _widget_point(window, z: complex) -> QPoint:
+    x, y = window.canvas.view.to_widget(z.real, z.imag)
+    return QPoint(round(x), round(y))
+
+
+def _drag(window, start: QPoint, path: list[QPoint]) -> None:
+    """Press on ``start``, move the pressed mouse along ``path``, release at its end."""
+    canvas = window.canvas
+    QTest.mousePress(canvas, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, start)
+    for p in path:
+        event = QMouseEvent(
+            QEvent.Type.MouseMove,
+            QPointF(p),
+            QPointF(canvas.mapToGlobal(p)),
+            Qt.MouseButton.NoButton,
+            Qt.MouseButton.LeftButton,
+            Qt.KeyboardModifier.NoModifier,
+        )
+        QApplication.sendEvent(canvas, event)
+    QTest.mouseRelease(canvas, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, path[-1])
+
+
+def test_selecting_an_instance_shows_the_handles_of_its_repetition(helix):
+    h = helix.handles.handles
+    d = helix.doc.drawing
+    assert h.rule == "P" and h.b0 == pytest.approx(d.b[5]) and h.b1 == pytest.approx(d.b[6])
+    assert set(h.points()) == {"move", "turn", "scale"}
+    assert helix.handles.hit(QPointF(_widget_point(helix, h.b1))) == "move"
+
+
+def test_dragging_the_next_repetition_changes_the_step_in_one_undo_step(helix, wait_idle):
+    doc = helix.doc
+    before = doc.text
+    h = helix.handles.handles
+    start = _widget_point(helix, h.b1)
+    path = [start + QPoint(dx, dx // 2) for dx in (4, 9, 15, 20)]
+    _drag(helix, start, path)
+    wait_idle(helix)
+    assert doc.undo_stack.count() == 1 and doc.undo_stack.undoText().startswith("Drag the step of P")
+    x, y = helix.canvas.view.to_doc(path[-1].x(), path[-1].y())
+    d = doc.drawing  # the step from 5 to 6, in 5's frame, goes where it was dropped
+    assert (d.b[6] - d.b[5]) / d.a[5] == pytest.approx((complex(x, y) - h.b0) / h.a0, abs=1e-9)
+    turn = doc.drawing.a[6] / doc.drawing.a[5]
+    assert math.degrees(cmath.phase(turn)) == pytest.approx(11.0)  # the turn per step stays
+    assert "+(-80) f(-24)" not in doc.text
+    doc.undo_stack.undo()
+    wait_idle(helix)
+    assert doc.text == before
+
+
+def test_the_turn_knob_sets_the_turn_per_step(helix, wait_idle):
+    doc = helix.doc
+    h = helix.handles.handles
+    start = _widget_point(helix, h.points()["turn"])
+    b1 = _widget_point(helix, h.b1)
+    target = b1 + QPoint(0, 48)  # straight down on screen: +90° in SVG coordinates
+    _drag(helix, start, [target])
+    wait_idle(helix)
+    d = doc.drawing  # the turn from 5 to 6 now points 6 at the knob, seen from 5's frame
+    turn = math.degrees(cmath.phase(d.a[6] / d.a[5]))
+    expected = math.remainder(90.0 - math.degrees(cmath.phase(h.a0)), 360.0)
+    assert turn == pytest.approx(expected, abs=2.0)
+    assert doc.undo_stack.count() == 1
+
+
+def test_plus_and_minus_change_the_count_by_one(helix, qtbot, wait_idle):
+    doc = helix.doc
+    base = _widget_point(helix, helix.handles.handles.b0)
+    n = len(doc.drawing)
+    QTest.mouseClick(
+        helix.canvas, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, base + QPoint(22, -22)
+    )
+    wait_idle(helix)
+    assert len(doc.drawing) == n + 1 and "P(41)" in doc.text and doc.undo_stack.count() == 1
+    base = _widget_point(helix, helix.handles.handles.b0)
+    QTest.mouseClick(
+        helix.canvas, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, base + QPoint(-22, -22)
+    )
+    wait_idle(helix)
+    assert len(doc.drawing) == n and doc.undo_stack.count() == 2
