@@ -77,15 +77,12 @@ class Tolerance:
 class Hierarchy:
     """Result of :func:`build_hierarchy`: rules, the axiom and statistics.
 
-    ``node_rule`` gives, for every input element, the index of the first rule that covered
-    it (-1: the axiom); ``closed`` is False when a last rule had to place nodes that no
-    repetition explains.
+    ``closed`` is False when a last rule had to place nodes that no repetition explains.
     """
 
     rules: tuple[Rule, ...]
     axiom: tuple[Module, ...]
     levels: int
-    node_rule: np.ndarray
     log: tuple[str, ...] = ()
     closed: bool = True
 
@@ -105,16 +102,13 @@ class _Context:
 
 
 class _Book:
-    """The rules written so far, the log, and which rule first covered every input element."""
+    """The rules written so far and the log."""
 
-    def __init__(self, n_elements: int):
+    def __init__(self) -> None:
         self.rules: list[Rule] = []
         self.log: list[str] = []
-        self.node_rule = np.full(n_elements, -1, np.int64)
 
-    def add(self, rule: Rule, log: str, members: list[np.ndarray]) -> None:
-        for mem in members:
-            self.node_rule[mem[self.node_rule[mem] < 0]] = len(self.rules)
+    def add(self, rule: Rule, log: str) -> None:
         self.rules.append(rule)
         self.log.append(log)
 
@@ -190,7 +184,7 @@ def build_hierarchy(
     sim = similarity if similarity is not None else np.full((nt, nt), 0.5) + 0.5 * np.eye(nt)
     table = SymbolTable(terminal_names, terminal_sizes, sim)
     ctx = _Context(table, tol)
-    book = _Book(np.asarray(a).size)
+    book = _Book()
     prec = precision
     if prec is None:
         prec = Precision.of_circles(np.asarray(center), np.asarray(radius), 0.0)
@@ -251,7 +245,7 @@ def build_hierarchy(
             break
     axiom = _axiom(table, book, nodes)
     report(progress, "rules", 1.0)
-    return Hierarchy(tuple(book.rules), axiom, level, book.node_rule, tuple(book.log), closed=len(nodes) == 1)
+    return Hierarchy(tuple(book.rules), axiom, level, tuple(book.log), closed=len(nodes) == 1)
 
 
 def _level_key(table: SymbolTable, nodes: Nodes, tol: Tolerance, neighbours: int, prec: Precision) -> bytes:
@@ -281,9 +275,7 @@ def _axiom(table: SymbolTable, book: _Book, nodes: Nodes) -> tuple[Module, ...]:
     for i in range(len(nodes)):
         body += [Push(), *(moves[i] if i else ()), *table.draw(int(nodes.sym[i]), last=True), Pop()]
     book.add(
-        Rule(name, False, (Case(None, tuple(body)),)),
-        f"{name}: places the {len(nodes)} remaining nodes",
-        list(nodes.members),
+        Rule(name, False, (Case(None, tuple(body)),)), f"{name}: places the {len(nodes)} remaining nodes"
     )
     return (*const_t(a0, b0), Symbol(name))
 
@@ -401,7 +393,7 @@ def _apply_all(table: SymbolTable, book: _Book, chosen: list[Candidate], nodes: 
     """Apply candidates on disjoint nodes one after another, renumbering the later ones' nodes."""
     for k, cand in enumerate(chosen):
         out = emit(table, cand)
-        book.add(out.rule, out.log, [np.concatenate([nodes.members[i] for i in g]) for g in out.groups])
+        book.add(out.rule, out.log)
         nodes, mapping = nodes.merge(
             list(out.groups), list(out.syms), list(cand.slack) or None, cand.starts or None
         )
