@@ -66,6 +66,8 @@ class Candidate:
     starts : tuple of complex pairs
         Per application, the pose it starts from when that is not its first node's pose
         (set when the candidate is accepted).
+    gain : float
+        Bits the rule saves (set when the candidate is accepted).
     """
 
     space: tuple[int, int]
@@ -76,6 +78,7 @@ class Candidate:
     start: float = 0.0
     slack: tuple[float, ...] = ()
     starts: tuple[tuple[complex, complex], ...] = ()
+    gain: float = 0.0
 
     @cached_property
     def covered(self) -> int:

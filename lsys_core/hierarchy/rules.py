@@ -32,7 +32,7 @@ from lsys_core.hierarchy.emit import const_t, const_t_many, emit
 from lsys_core.hierarchy.gain import Ledger, placement_error
 from lsys_core.hierarchy.mdl import Precision
 from lsys_core.hierarchy.nodes import Nodes
-from lsys_core.hierarchy.snap import SHARE, snapped
+from lsys_core.hierarchy.snap import SHARE, plainer, snapped
 from lsys_core.hierarchy.spaces import pair_space
 from lsys_core.hierarchy.symbols import SymbolTable
 from lsys_core.settings import setting
@@ -325,6 +325,26 @@ def _worthwhile(
     not on the page), ``measure`` tells how far the derived element really is.
     """
     c = snapped(c, nodes, limit, snap)
+    for variant in (plainer(c), c):  # a transform without its small turn and scale, if it fits
+        if variant is None:
+            continue
+        accepted = _admitted(variant, ledger, nodes, sizes, period, measure, n_terminals, limit)
+        if accepted is not None:
+            return accepted
+    return None
+
+
+def _admitted(
+    c: Candidate,
+    ledger: Ledger,
+    nodes: Nodes,
+    sizes: np.ndarray,
+    period: np.ndarray,
+    measure: Measure | None,
+    n_terminals: int,
+    limit: float,
+) -> Candidate | None:
+    """``c`` with its slack, starts and gain set, if it places its nodes within their slack and pays."""
     idx, err, starts, (pa, pb) = placement_error(c, nodes, sizes, period)
     left = nodes.slack[idx] - err
     over = np.flatnonzero(left < 0.0)
@@ -335,13 +355,14 @@ def _worthwhile(
         if single.all():
             elements = np.array([int(nodes.members[i][0]) for i in idx[over]])
             left[over] = limit - measure(elements, pa[over], pb[over])
-    if (left < 0.0).any() or ledger.gain(c) <= 0.0:
+    gain = ledger.gain(c) if not (left < 0.0).any() else 0.0
+    if gain <= 0.0:
         return None
     owner = np.repeat(np.arange(len(c.groups)), [g.size for g in c.groups])
     slack = np.full(len(c.groups), np.inf)
     np.minimum.at(slack, owner, left)
     poses = () if starts is None else tuple(zip(starts[0].tolist(), starts[1].tolist(), strict=True))
-    return replace(c, slack=tuple(float(v) for v in slack), starts=poses)
+    return replace(c, slack=tuple(float(v) for v in slack), starts=poses, gain=gain)
 
 
 def _scores(cands: list[Candidate], w: Weights) -> np.ndarray:
@@ -361,31 +382,36 @@ def _choose(
 ) -> list[Candidate]:
     """The candidates to apply at this level, most important first (§5.4–§5.5).
 
-    Candidates are taken in order of importance (ties, e.g. a sequence read forwards or
-    backwards, go to the order the art was drawn in); the first ``worthwhile`` one is applied.
+    Candidates are taken in order of importance; among equally important ones the one that
+    shortens the description most (then covers most, then comes first in the drawing: a
+    sequence read forwards or backwards) is applied.
     When it covers only a small part of the scene (weak structure among clutter), every other
     worthwhile candidate on disjoint nodes is applied in the same level, so the number of
     levels stays small.  Only the candidates looked at are tested.
     """
-    scores = _scores(cands, weights)
+    scores = np.round(_scores(cands, weights), 9)
     order = sorted(
-        range(len(cands)),
-        key=lambda i: (round(float(scores[i]), 9), cands[i].covered, -cands[i].start),
-        reverse=True,
+        range(len(cands)), key=lambda i: (scores[i], cands[i].covered, -cands[i].start), reverse=True
     )
     taken = np.zeros(n_nodes, bool)
     out: list[Candidate] = []
-    for i in order:
-        nodes = cands[i].nodes()
-        if taken[nodes].any():
-            continue
-        c = worthwhile(cands[i])
-        if c is None:
-            continue
-        taken[nodes] = True
-        out.append(c)
-        if out[0].covered >= WEAK_COVER * n_nodes:
-            break
+    k = 0
+    while k < len(order):
+        # candidates of equal importance: the one that shortens the description most goes first
+        tied = [i for i in order[k:] if scores[i] == scores[order[k]]]
+        k += len(tied)
+        found = []
+        for i in tied:
+            if not taken[cands[i].nodes()].any() and (c := worthwhile(cands[i])) is not None:
+                found.append(c)
+        for c in sorted(found, key=lambda c: (c.gain, c.covered, -c.start), reverse=True):
+            nodes = c.nodes()
+            if taken[nodes].any():
+                continue
+            taken[nodes] = True
+            out.append(c)
+            if out[0].covered >= WEAK_COVER * n_nodes:
+                return out
     return out
 
 

@@ -14,6 +14,8 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+import numpy as np
+
 from lsys_core.geometry.transforms import rel_from_t4, t4_from_rel
 from lsys_core.hierarchy.candidates import (
     BranchCandidate,
@@ -26,7 +28,7 @@ from lsys_core.hierarchy.emit import nice
 from lsys_core.hierarchy.gain import group_reach
 from lsys_core.hierarchy.nodes import Nodes
 
-__all__ = ["SHARE", "snapped"]
+__all__ = ["PLAIN_SCALE", "PLAIN_TURN", "SHARE", "plainer", "snapped"]
 
 #: Share of the tolerance the rounding of one candidate may spend (:func:`symmetrize
 #: <lsys_core.pipeline.symmetrize>`, whose purpose is regularity, lets it spend more).
@@ -76,3 +78,22 @@ def snapped(c: Candidate, nodes: Nodes, eps: float, share: float = SHARE) -> Can
             d_beta=nice(c.d_beta, abs_tol=slope),
         )
     return c
+
+
+#: Turns (degrees) and scale changes (relative) up to these may be dropped by :func:`plainer`.
+PLAIN_TURN = 2.0
+PLAIN_SCALE = 0.02
+
+
+def plainer(c: Candidate) -> Candidate | None:
+    """``c`` with a small turn and scale change of its transform dropped (a pure step), or None.
+
+    A row of hand-placed copies measures a turn of a fraction of a degree per step; when the
+    plain step still places every copy within the tolerance it is the simpler rule.
+    """
+    if not isinstance(c, (SeqCandidate, PairCandidate)) or abs(c.A - 1.0) < 1e-12:
+        return None
+    turn = math.degrees(float(np.angle(c.A)))
+    if abs(turn) > PLAIN_TURN or abs(math.log(abs(c.A))) > PLAIN_SCALE:
+        return None
+    return replace(c, A=1.0 + 0j)
