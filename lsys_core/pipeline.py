@@ -13,7 +13,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from lsys_core.cancel import CancelToken, Progress, check, report
-from lsys_core.derive.derivation import derive
+from lsys_core.derive.derivation import derive, derive_traced
+from lsys_core.derive.faithful import fit_paint, match_instances
 from lsys_core.derive.model import Drawing
 from lsys_core.errors import InferenceError
 from lsys_core.grammar.model import Grammar
@@ -278,6 +279,29 @@ def _instancing(scene: Scene, settings: InferenceSettings, tolerance: float, can
     return regular_scales(scene, medoids(scene, inst, tolerance), tolerance)
 
 
+def paint_like_input(grammar: Grammar, scene: Scene, inst: Instancing) -> Grammar:
+    """Give an inferred grammar the input's names, styles, paint order, defs and verbatim content.
+
+    The grammar is derived once
+    and each instance matched to its element (:func:`~lsys_core.derive.faithful.fit_paint`);
+    the scene's ``defs`` and verbatim content are carried over, each verbatim item placed
+    after the instances of the elements that precede it in the document.
+    """
+    orders = np.array([e.order if e.order >= 0 else i for i, e in enumerate(scene.elements)], float)
+    drawing, trace = derive_traced(grammar, limit=max(10 * len(scene.elements), 1000))
+    names = [inst.terminals[g].name for g in inst.group]
+    match = match_instances(
+        [t.name for t in drawing.terminals], drawing.symbol, drawing.a, drawing.b, names, inst.a, inst.b
+    )
+    if match is not None:
+        grammar = fit_paint(grammar, [e.style for e in scene.elements], orders, match, trace)
+    verbatim = tuple(
+        replace(v, order=int(np.count_nonzero(orders < v.order)))
+        for v in sorted(scene.verbatim, key=lambda v: v.order)
+    )
+    return replace(grammar, defs=scene.defs, verbatim=verbatim)
+
+
 @dataclass(frozen=True, eq=False)
 class Analysis:
     """What inference computes once per scene, whatever the importance weights (§4, §5.3).
@@ -458,6 +482,9 @@ def rules_from_analysis(
     assert best is not None  # _factors is never empty and the first try is always kept
     grammar, hier, error, bits, drawing = best
     stages["reproduction_error"] = reproduction_error(inst, sizes, drawing) / diag
+    t = time.perf_counter()
+    grammar = paint_like_input(grammar, scene, inst)
+    stages["paint"] = time.perf_counter() - t
     report(progress, "done", 1.0)
     segments = np.array([e.cubics.shape[0] for e in scene.elements])
     return InferenceResult(

@@ -1,44 +1,67 @@
 """Derive a grammar into a :class:`~lsys_core.derive.model.Drawing`: rewriting and turtle interpretation.
 
 The derivation is level-batched and vectorised: all pending calls of one non-terminal are
-expanded at once, each as numpy arrays of counters ``m`` and turtle frames ``(a, b)``
-(complex, see :mod:`lsys_core.geometry.transforms`).  A case that ends with a call to its own symbol
-with ``m - c`` (a *sequence*, the paper's r1) is unrolled in one step: the frames of all
-``m`` repetitions are a segmented cumulative product, so a 10⁶-element sequence costs a
-few numpy calls, not 10⁶ Python iterations.  Branching rules (r3) take one batch per level.
+expanded at once, each as numpy arrays of counters ``m``, turtle frames ``(a, b)``
+(complex, see :mod:`lsys_core.geometry.transforms`) and paint-order values ``z``.  A case
+that ends with a call to its own symbol with ``m - c`` (a *sequence*, the paper's r1) is
+unrolled in one step: the frames of all ``m`` repetitions are a segmented cumulative product,
+so a 10⁶-element sequence costs a few numpy calls, not 10⁶ Python iterations.  Branching
+rules (r3) take one batch per level.
 
 Semantics: a parametric symbol with ``m < 0`` draws nothing; a case without a condition
 applies for ``m >= 0``; a symbol with no matching case draws nothing (the paper's implicit
 identity rule ``r0`` leaves it in the string, and a non-terminal has no interpretation).
+
+Paint order: the instances are returned sorted by ``z`` (the turtle's paint-order value,
+moved by ``z(Δ)`` and offset by the grammar's ``order:`` table), ties in the order the
+terminals stand in the derived string (see :mod:`.order`).
 """
 
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from lsys_core.cancel import CancelToken, check
+from lsys_core.derive.compile import Compiled, Program, compile_grammar
+from lsys_core.derive.jitter import jitter_instances
 from lsys_core.derive.model import Drawing
-from lsys_core.errors import GrammarError, LimitError
+from lsys_core.derive.order import Items, string_positions
+from lsys_core.derive.paint import paint_z, resolve_styles
+from lsys_core.errors import LimitError
 from lsys_core.geometry.transforms import DEG
-from lsys_core.grammar.model import COND_EQ0, COND_GT0, Case, Grammar, Pop, Push, Randomize, Symbol, Turtle
+from lsys_core.grammar.model import COND_EQ0, COND_GT0, Case, Grammar, Randomize
 
-__all__ = ["DEFAULT_LIMIT", "Randomize", "derive"]
+__all__ = ["DEFAULT_LIMIT", "Randomize", "Trace", "derive", "derive_traced"]
 
 DEFAULT_LIMIT = 1_000_000
 
 
-# Compiled body ops: ("t", op, c0, cd) turtle, ("[",) push, ("]",) pop,
-# ("draw", terminal index), ("call", rule index, k0, k1).
-_Op = tuple
+@dataclass(frozen=True, eq=False)
+class Trace:
+    """Where each instance of a :class:`Drawing` came from (same order as the drawing).
 
+    Attributes
+    ----------
+    position : ndarray of int64
+        Position in the derived string (derivation order).
+    slot : ndarray of int64
+        Terminal occurrence that drew it: an index into ``slots``.
+    m : ndarray of int64
+        Counter of the rule application that drew it (0 in the axiom).
+    z : ndarray of float
+        Paint-order value (``z`` modules plus the ``order:`` table).
+    slots : tuple of (str, int, int)
+        ``(owner, case, module index)`` of every terminal occurrence.
+    """
 
-@dataclass
-class _Compiled:
-    ops: list[_Op]
-    tail: tuple[int, int] | None  # (step c, index where the tail call starts) for a self sequence
+    position: np.ndarray
+    slot: np.ndarray
+    m: np.ndarray
+    z: np.ndarray
+    slots: tuple[tuple[str, int, int], ...]
 
 
 class _Emitter:
@@ -47,7 +70,7 @@ class _Emitter:
     def __init__(self, limit: int) -> None:
         self.limit = limit
         self.count = 0
-        self.parts: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        self.parts: list[tuple[np.ndarray, ...]] = []
 
     def reserve(self, n: int, where: str) -> None:
         if self.count + n > self.limit:
@@ -56,49 +79,24 @@ class _Emitter:
                 "lower its counter m or raise the limit"
             )
 
-    def add(self, term: int, a: np.ndarray, b: np.ndarray, rule: int) -> None:
+    def add(self, op: tuple, rule: int, a, b, z, m, parent, rank) -> None:
         n = a.size
         self.count += n
-        self.parts.append((np.full(n, term, np.int32), a, b, np.full(n, rule, np.int32)))
-
-
-def _compile(grammar: Grammar) -> tuple[list[list[_Compiled]], dict[str, int], dict[str, int]]:
-    terms = {t.name: i for i, t in enumerate(grammar.terminals)}
-    rules = {r.name: i for i, r in enumerate(grammar.rules)}
-
-    def body_ops(body, owner: str) -> list[_Op]:
-        ops: list[_Op] = []
-        for mod in body:
-            if isinstance(mod, Turtle):
-                ops.append(("t", mod.op, float(mod.value.c0), float(mod.value.cd)))
-            elif isinstance(mod, Push):
-                ops.append(("[",))
-            elif isinstance(mod, Pop):
-                ops.append(("]",))
-            elif isinstance(mod, Symbol):
-                if mod.name in terms:
-                    ops.append(("draw", terms[mod.name]))
-                elif mod.name in rules:
-                    arg = mod.arg
-                    ops.append(("call", rules[mod.name], arg.k0 if arg else 0, arg.k1 if arg else 0))
-                else:
-                    raise GrammarError(f"undefined symbol {mod.name} in {owner}")
-        return ops
-
-    compiled = []
-    for ri, rule in enumerate(grammar.rules):
-        cases = []
-        for case in rule.cases:
-            ops = body_ops(case.body, f"rule {rule.name}")
-            tail = None
-            if rule.parametric and ops and ops[-1][0] == "call" and ops[-1][1] == ri:
-                _, _, k0, k1 = ops[-1]
-                depth = sum(1 if o[0] == "[" else -1 if o[0] == "]" else 0 for o in ops)
-                if k1 == 1 and k0 <= -1 and depth == 0:
-                    tail = (-k0, len(ops) - 1)
-            cases.append(_Compiled(ops, tail))
-        compiled.append(cases)
-    return compiled, terms, rules
+        _, term, paint, slot = op
+        self.parts.append(
+            (
+                np.full(n, term, np.int32),
+                a,
+                b,
+                np.broadcast_to(np.asarray(z, float), (n,)),
+                np.full(n, rule, np.int32),
+                np.broadcast_to(np.asarray(m, np.int64), (n,)),
+                np.full(n, slot, np.int64),
+                np.full(n, paint, np.int32),
+                np.broadcast_to(np.asarray(parent, np.int64), (n,)),
+                np.broadcast_to(np.asarray(rank, np.int64), (n,)),
+            )
+        )
 
 
 def _case_masks(rule_cases: tuple[Case, ...], m: np.ndarray) -> list[np.ndarray]:
@@ -119,29 +117,27 @@ def _case_masks(rule_cases: tuple[Case, ...], m: np.ndarray) -> list[np.ndarray]
 
 
 class _Interpreter:
-    """Interpret compiled bodies for a batch of items, starting at identity frames."""
+    """Interpret compiled bodies for a batch of items."""
 
-    def __init__(self, randomize: Randomize | None, emitter: _Emitter, pending, limit: int) -> None:
+    def __init__(self, randomize: Randomize | None) -> None:
         self.rand = randomize if randomize is not None and randomize.active else None
         self.rng = np.random.default_rng(randomize.seed if randomize is not None else 0)
-        self.emitter = emitter
-        self.pending = pending
-        self.limit = limit
 
-    def run(self, ops, m, rule: int, where: str, a0=None, b0=None, perturb: bool = True):
-        """Run ``ops`` for counters ``m``; frames start at ``(a0, b0)`` (identity if None).
+    def run(self, ops, m, a=None, b=None, z=None, perturb: bool = True):
+        """Run ``ops`` for counters ``m``; the state starts at ``(a, b, z)`` (identity, 0 if None).
 
-        Returns the frames after the last op and the emitted terminal instances as a list of
-        ``(terminal, a, b)``; calls are pushed to the pending queue with their frames.
+        Returns the state after the last op, the draws ``(op index, op, a, b, z)`` and the
+        calls ``(op index, target, m, a, b, z)``.
         """
         n = m.size
-        a = np.ones(n, complex) if a0 is None else a0
-        b = np.zeros(n, complex) if b0 is None else b0
+        a = np.ones(n, complex) if a is None else a
+        b = np.zeros(n, complex) if b is None else b
+        z = np.zeros(n) if z is None else z
         stack = []
-        draws: list[tuple[int, np.ndarray, np.ndarray]] = []
+        draws = []
         calls = []
         rand = self.rand if perturb else None
-        for op in ops:
+        for i, op in enumerate(ops):
             kind = op[0]
             if kind == "t":
                 _, sym, c0, cd = op
@@ -154,21 +150,23 @@ class _Interpreter:
                     if rand is not None and rand.scale:
                         v = v * (1.0 + self.rng.uniform(-rand.scale, rand.scale, n))
                     a = a * v
+                elif sym == "z":
+                    z = z + v
                 else:
                     ang = v if sym == "+" else -v
                     if rand is not None and rand.angle:
                         ang = ang + self.rng.uniform(-rand.angle, rand.angle, n)
                     a = a * np.exp(1j * DEG * ang)
             elif kind == "[":
-                stack.append((a, b))
+                stack.append((a, b, z))
             elif kind == "]":
-                a, b = stack.pop()
+                a, b, z = stack.pop()
             elif kind == "draw":
-                draws.append((op[1], a, b))
+                draws.append((i, op, a, b, z))
             else:
                 _, target, k0, k1 = op
-                calls.append((target, k0 + k1 * m, a, b))
-        return a, b, draws, calls
+                calls.append((i, target, k0 + k1 * m, a, b, z))
+        return a, b, z, draws, calls
 
 
 def _segmented_exclusive_cumsum(x: np.ndarray, starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
@@ -209,7 +207,7 @@ def derive(
     Parameters
     ----------
     grammar : Grammar
-        The L-system; the turtle starts at the origin, heading +x, scale 1.
+        The L-system; the turtle starts at the origin, heading +x, scale 1, ``z`` 0.
     limit : int
         Maximum number of terminal instances; exceeding it raises :class:`LimitError`
         naming the rule, before the arrays are allocated.
@@ -222,205 +220,206 @@ def derive(
     Returns
     -------
     Drawing
-        Terminal instances with their poses, in a deterministic order.
+        Terminal instances with their poses and styles, in paint order: by ``z``, then in
+        the order of the derived string.
     """
-    with np.errstate(all="ignore"):
-        return _derive(grammar, limit, randomize, cancel)
+    return derive_traced(grammar, limit=limit, randomize=randomize, cancel=cancel)[0]
 
 
-def _derive(grammar: Grammar, limit: int, randomize: Randomize | None, cancel: CancelToken | None) -> Drawing:
+def derive_traced(
+    grammar: Grammar,
+    *,
+    limit: int = DEFAULT_LIMIT,
+    randomize: Randomize | None = None,
+    cancel: CancelToken | None = None,
+) -> tuple[Drawing, Trace]:
+    """Like :func:`derive`, and also return the :class:`Trace` of every instance."""
     if randomize is None:
         randomize = grammar.randomize
     if randomize is not None and not randomize.active:
         randomize = None
     per_instance = randomize is not None and randomize.jitter == "instance"
-    compiled, _, _ = _compile(grammar)
-    emitter = _Emitter(limit)
-    work_budget = 4 * max(limit, 1000)
-    work = 0
-    pending: dict[int, list] = {}
-    order: deque[int] = deque()
+    with np.errstate(all="ignore"):
+        drawing, trace = _Derivation(grammar, limit, None if per_instance else randomize, cancel).run()
+    if per_instance and randomize is not None:
+        drawing = jitter_instances(drawing, randomize)
+    return drawing, trace
 
-    def push(target: int, m: np.ndarray, a: np.ndarray, b: np.ndarray) -> None:
+
+class _Derivation:
+    """One derivation: the queue of pending calls, the emitted instances and the item tree."""
+
+    def __init__(self, grammar: Grammar, limit: int, randomize, cancel) -> None:
+        self.grammar = grammar
+        self.program: Program = compile_grammar(grammar)
+        self.limit = limit
+        self.cancel = cancel
+        self.emitter = _Emitter(limit)
+        self.interp = _Interpreter(randomize)
+        self.items = Items()
+        self.work_budget = 4 * max(limit, 1000)
+        self.work = 0
+        self.pending: dict[int, list] = {}
+        self.queue: deque[int] = deque()
+
+    def push(self, target: int, m, a, b, z, parent, rank) -> None:
+        """Queue calls of rule ``target`` (dropping parametric ones with a negative counter)."""
+        m = np.asarray(m, np.int64)
         if m.size == 0:
             return
-        if grammar.rules[target].parametric:
+        parent = np.broadcast_to(np.asarray(parent, np.int64), m.shape)
+        rank = np.broadcast_to(np.asarray(rank, np.int64), m.shape)
+        z = np.broadcast_to(np.asarray(z, float), m.shape)
+        if self.grammar.rules[target].parametric:
             keep = m >= 0
             if not keep.all():
-                m, a, b = m[keep], a[keep], b[keep]
+                m, a, b, z, parent, rank = m[keep], a[keep], b[keep], z[keep], parent[keep], rank[keep]
                 if m.size == 0:
                     return
-        if target not in pending:
-            pending[target] = []
-            order.append(target)
-        pending[target].append((m, a, b))
+        ids = self.items.add(parent, rank)
+        if target not in self.pending:
+            self.pending[target] = []
+            self.queue.append(target)
+        self.pending[target].append((m, a, b, z, ids))
 
-    interp = _Interpreter(None if per_instance else randomize, emitter, pending, limit)
+    def emit(self, draws, rule: int, where: str, m, parent, rank, base=None) -> None:
+        """Record drawn instances; ``base`` ``(a, b, z)`` maps step-relative states to absolute."""
+        for _, op, a, b, z in draws:
+            if base is not None:
+                a, b, z = base[0] * a, base[0] * b + base[1], base[2] + z
+            self.emitter.reserve(a.size, where)
+            if not (np.isfinite(a).all() and np.isfinite(b).all()):
+                raise LimitError(
+                    f"derivation overflows in {where}: its scales or distances grow beyond floating-point range"
+                )
+            self.emitter.add(op, rule, a, b, z, m, parent, rank)
 
-    def emit(draws, rule: int, where: str, a_base=None, b_base=None) -> None:
-        for term, a, b in draws:
-            if a_base is not None:
-                a, b = a_base * a, a_base * b + b_base
-            emitter.reserve(a.size, where)
-            _check_finite(a, b, where)
-            emitter.add(term, a, b, rule)
+    def run(self) -> tuple[Drawing, Trace]:
+        one = np.zeros(1, np.int64)
+        root = np.zeros(1, np.int64)
+        _, _, _, draws, calls = self.interp.run(self.program.axiom, one, perturb=False)
+        for i, op, a, b, z in draws:
+            self.emit([(i, op, a, b, z)], -1, "the axiom", one, root, i)
+        for i, target, m, a, b, z in calls:
+            self.push(target, m, a, b, z, root, i)
+        while self.queue:
+            check(self.cancel)
+            self.expand(self.queue.popleft())
+        return self.collect()
 
-    # The axiom: one item, no counter, not perturbed.
-    one = np.zeros(1, np.int64)
-    axiom_ops = _compile_axiom(grammar)
-    _, _, draws, calls = interp.run(axiom_ops, one, -1, "the axiom", perturb=False)
-    emit(draws, -1, "the axiom")
-    for target, m, a, b in calls:
-        push(target, m.astype(np.int64), a, b)
-
-    while order:
-        check(cancel)
-        r = order.popleft()
-        batches = pending.pop(r)
-        rule = grammar.rules[r]
+    def expand(self, r: int) -> None:
+        """Expand every pending call of rule ``r``."""
+        batches = self.pending.pop(r)
+        rule = self.grammar.rules[r]
         where = f"rule {rule.name}"
-        m = np.concatenate([x[0] for x in batches]).astype(np.int64)
-        a = np.concatenate([x[1] for x in batches])
-        b = np.concatenate([x[2] for x in batches])
-        work += m.size
-        if m.size > limit or work > work_budget:
-            raise LimitError(f"derivation exceeds the element limit ({limit:,} elements) in {where}")
+        m, a, b, z, ids = (np.concatenate([x[k] for x in batches]) for k in range(5))
+        self.work += m.size
+        if m.size > self.limit or self.work > self.work_budget:
+            raise LimitError(f"derivation exceeds the element limit ({self.limit:,} elements) in {where}")
         masks = (
             _case_masks(rule.cases, m)
             if rule.parametric
             else [np.ones(m.size, bool)] + [np.zeros(m.size, bool)] * (len(rule.cases) - 1)
         )
-        for ci, case in enumerate(compiled[r]):
+        for ci, case in enumerate(self.program.rules[r]):
             sel = masks[ci]
             if not sel.any():
                 continue
-            ms, as_, bs = m[sel], a[sel], b[sel]
+            ms, as_, bs, zs, ids_ = m[sel], a[sel], b[sel], z[sel], ids[sel]
             if case.tail is None:
-                _, _, draws, calls = interp.run(case.ops, ms, r, where, as_, bs)
-                emit(draws, r, where)
-                for target, mm, ca, cb in calls:
-                    push(target, np.asarray(mm, np.int64), ca, cb)
-                continue
-            _unroll(interp, emit, push, rule, r, ci, case, ms, as_, bs, where, work_budget - work)
-    drawing = _collect(grammar, emitter)
-    if per_instance and randomize is not None:
-        return _jitter_instances(drawing, randomize)
-    return drawing
+                _, _, _, draws, calls = self.interp.run(case.ops, ms, as_, bs, zs)
+                for i, op, da, db, dz in draws:
+                    self.emit([(i, op, da, db, dz)], r, where, ms, ids_, i)
+                for i, target, mm, ca, cb, cz in calls:
+                    self.push(target, mm, ca, cb, cz, ids_, i)
+            else:
+                self.unroll(r, ci, case, ms, as_, bs, zs, ids_, where)
 
+    def unroll(self, r, ci, case: Compiled, m, a, b, z, ids, where) -> None:
+        """Expand a self-sequence case for all items at once (see the module docstring)."""
+        rule = self.grammar.rules[r]
+        assert case.tail is not None
+        c, tail_at = case.tail
+        stride = tail_at + 1  # ranks: step k's op j is k * stride + j; the continuation comes last
+        conds = [k.cond for k in rule.cases]
+        first_pos = next((i for i, k in enumerate(conds) if k in (COND_GT0, None)), None)
+        first_zero = next((i for i, k in enumerate(conds) if k in (COND_EQ0, None)), None)
+        lengths = np.zeros(m.size, np.int64)
+        if first_pos == ci:
+            lengths = np.where(m > 0, -(-m // c), 0)
+        if first_zero == ci:
+            lengths = lengths + ((m - lengths * c) == 0)
+        total = int(lengths.sum())
+        if total > self.work_budget - self.work:
+            raise LimitError(
+                f"derivation exceeds the element limit in {where}: {total:,} repetitions requested; "
+                "lower its counter m or raise the limit"
+            )
+        draws_per_step = sum(1 for op in case.ops if op[0] == "draw")
+        self.emitter.reserve(total * draws_per_step, where)
+        starts = np.concatenate(([0], np.cumsum(lengths)[:-1])).astype(np.int64)
+        owner = np.repeat(np.arange(m.size), lengths)
+        k = np.arange(total) - np.repeat(starts, lengths)
+        m_step = m[owner] - k * c
+        a_net, b_net, z_net, draws, calls = self.interp.run(case.ops[:tail_at], m_step)
+        rel_a, rel_b = _chain_frames(a_net, b_net, starts, lengths)
+        step_a = a[owner] * rel_a
+        step_b = a[owner] * rel_b + b[owner]
+        step_z = z[owner] + _segmented_exclusive_cumsum(z_net, starts, lengths)
+        parent = ids[owner]
+        for i, op, da, db, dz in draws:
+            self.emit(
+                [(i, op, da, db, dz)], r, where, m_step, parent, k * stride + i, (step_a, step_b, step_z)
+            )
+        for i, target, mm, ca, cb, cz in calls:
+            self.push(target, mm, step_a * ca, step_a * cb + step_b, step_z + cz, parent, k * stride + i)
+        # Continue after the last step of every chain (another case, e.g. m == 0, takes over).
+        last = starts + lengths - 1
+        has = lengths > 0
+        end_a = np.where(has, a, 0j)
+        end_b = np.where(has, b, 0j)
+        end_z = np.where(has, z, 0.0)
+        if has.any():
+            li = last[has]
+            end_a[has] = step_a[li] * a_net[li]
+            end_b[has] = step_a[li] * b_net[li] + step_b[li]
+            end_z[has] = step_z[li] + z_net[li]
+        m_end = m - lengths * c
+        keep = has & (m_end >= 0)
+        self.push(r, m_end[keep], end_a[keep], end_b[keep], end_z[keep], ids[keep], lengths[keep] * stride)
 
-def _check_finite(a: np.ndarray, b: np.ndarray, where: str) -> None:
-    """Raise :class:`LimitError` when poses left the floating-point range (or became NaN)."""
-    if not (np.isfinite(a).all() and np.isfinite(b).all()):
-        raise LimitError(
-            f"derivation overflows in {where}: its scales or distances grow beyond floating-point range"
-        )
-
-
-def _compile_axiom(grammar: Grammar) -> list[_Op]:
-    rule_idx = {r.name: i for i, r in enumerate(grammar.rules)}
-    term_idx = {t.name: i for i, t in enumerate(grammar.terminals)}
-    ops: list[_Op] = []
-    for mod in grammar.axiom:
-        if isinstance(mod, Turtle):
-            ops.append(("t", mod.op, float(mod.value.c0), 0.0))
-        elif isinstance(mod, Push):
-            ops.append(("[",))
-        elif isinstance(mod, Pop):
-            ops.append(("]",))
-        elif mod.name in term_idx:
-            ops.append(("draw", term_idx[mod.name]))
-        elif mod.name in rule_idx:
-            ops.append(("call", rule_idx[mod.name], mod.arg.k0 if mod.arg else 0, 0))
+    def collect(self) -> tuple[Drawing, Trace]:
+        """Sort the instances into paint order and build the drawing and its trace."""
+        g = self.grammar
+        parts = self.emitter.parts
+        if parts:
+            cols = [np.concatenate([p[k] for p in parts]) for k in range(10)]
         else:
-            raise GrammarError(f"undefined symbol {mod.name} in the axiom")
-    return ops
-
-
-def _unroll(interp, emit, push, rule, r, ci, case, m, a, b, where, budget) -> None:
-    """Expand a self-sequence case for all items at once (see the module docstring)."""
-    c, tail_at = case.tail
-    conds = [k.cond for k in rule.cases]
-    first_pos = next((i for i, k in enumerate(conds) if k in (COND_GT0, None)), None)
-    first_zero = next((i for i, k in enumerate(conds) if k in (COND_EQ0, None)), None)
-    lengths = np.zeros(m.size, np.int64)
-    if first_pos == ci:
-        lengths = np.where(m > 0, -(-m // c), 0)
-    if first_zero == ci:
-        lengths = lengths + ((m - lengths * c) == 0)
-    total = int(lengths.sum())
-    if total > budget:
-        raise LimitError(
-            f"derivation exceeds the element limit in {where}: {total:,} repetitions requested; "
-            "lower its counter m or raise the limit"
+            cols = [np.zeros(0, t) for t in (np.int32, complex, complex, float, np.int32)]
+            cols += [np.zeros(0, t) for t in (np.int64, np.int64, np.int32, np.int64, np.int64)]
+        sym, a, b, z, rule, m, slot, paint, parent, rank = cols
+        pos = string_positions(self.items, parent, rank)
+        z = z.astype(float) + paint_z(self.program.paints, paint, m)
+        if g.order:
+            table = np.asarray(g.order, float)
+            listed = pos < table.size
+            z[listed] += table[pos[listed]]
+        order = np.lexsort((pos, z))
+        sym, a, b, z, rule, m, slot, paint, pos = (
+            x[order] for x in (sym, a, b, z, rule, m, slot, paint, pos)
         )
-    draws_per_step = sum(1 for op in case.ops if op[0] == "draw")
-    interp.emitter.reserve(total * draws_per_step, where)
-    starts = np.concatenate(([0], np.cumsum(lengths)[:-1])).astype(np.int64)
-    owner = np.repeat(np.arange(m.size), lengths)
-    k = np.arange(total) - np.repeat(starts, lengths)
-    m_step = m[owner] - k * c
-    a_net, b_net, draws, calls = interp.run(case.ops[:tail_at], m_step, r, where)
-    rel_a, rel_b = _chain_frames(a_net, b_net, starts, lengths)
-    step_a = a[owner] * rel_a
-    step_b = a[owner] * rel_b + b[owner]
-    emit(draws, r, where, step_a, step_b)
-    for target, mm, ca, cb in calls:
-        push(target, np.asarray(mm, np.int64), step_a * ca, step_a * cb + step_b)
-    # Continue after the last step of every chain (another case, e.g. m == 0, takes over).
-    last = starts + lengths - 1
-    has = lengths > 0
-    end_a = np.where(has, a, 0j)
-    end_b = np.where(has, b, 0j)
-    if has.any():
-        li = last[has]
-        end_a[has] = step_a[li] * a_net[li]
-        end_b[has] = step_a[li] * b_net[li] + step_b[li]
-    m_end = m - lengths * c
-    keep = has & (m_end >= 0)
-    push(r, m_end[keep], end_a[keep], end_b[keep])
-
-
-def _collect(grammar: Grammar, emitter: _Emitter) -> Drawing:
-    parts = emitter.parts
-    if parts:
-        sym = np.concatenate([p[0] for p in parts])
-        a = np.concatenate([p[1] for p in parts]).astype(complex)
-        b = np.concatenate([p[2] for p in parts]).astype(complex)
-        rule = np.concatenate([p[3] for p in parts])
-    else:
-        sym = np.zeros(0, np.int32)
-        a = np.zeros(0, complex)
-        b = np.zeros(0, complex)
-        rule = np.zeros(0, np.int32)
-    return Drawing(grammar.terminals, sym, a, b, rule, grammar.viewbox, grammar.size)
-
-
-def _jitter_instances(drawing: Drawing, rnd: Randomize) -> Drawing:
-    """Perturb every instance drawn by a rule on its own (``jitter="instance"``, see ``Randomize``)."""
-    sel = np.flatnonzero(drawing.rule >= 0)
-    if sel.size == 0:
-        return drawing
-    rng = np.random.default_rng(rnd.seed)
-    a, b = drawing.a.copy(), drawing.b.copy()
-    n = sel.size
-    turn = np.exp(1j * DEG * rng.uniform(-rnd.angle, rnd.angle, n)) if rnd.angle else 1.0
-    grow = 1.0 + rng.uniform(-rnd.scale, rnd.scale, n) if rnd.scale else 1.0
-    if rnd.distance:
-        gap = _nearest_gap(b)[sel]
-        heading = a[sel] / np.where(np.abs(a[sel]) > 0, np.abs(a[sel]), 1.0)
-        offset = rng.uniform(-1.0, 1.0, n) + 1j * rng.uniform(-1.0, 1.0, n)
-        b[sel] = b[sel] + rnd.distance * gap * heading * offset
-    a[sel] = a[sel] * turn * grow
-    return replace(drawing, a=a, b=b)
-
-
-def _nearest_gap(points: np.ndarray) -> np.ndarray:
-    """Return each point's distance to its nearest other point (0 when it is alone)."""
-    if points.size < 2:
-        return np.zeros(points.size)
-    from scipy.spatial import cKDTree
-
-    xy = np.column_stack([points.real, points.imag])
-    dist, _ = cKDTree(xy).query(xy, k=2)
-    gap = dist[:, 1]
-    return np.where(np.isfinite(gap), gap, 0.0)
+        styles, style = resolve_styles(g, self.program.paints, sym, paint, m, pos)
+        drawing = Drawing(
+            g.terminals,
+            sym,
+            a.astype(complex),
+            b.astype(complex),
+            rule,
+            g.viewbox,
+            g.size,
+            styles=styles,
+            style=style,
+            defs=g.defs,
+            verbatim=g.verbatim,
+        )
+        return drawing, Trace(pos, slot, m, z, tuple(self.program.slots))

@@ -7,14 +7,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from lsys_core.geometry.transforms import frames_to_matrices
-from lsys_core.grammar.model import Terminal
+from lsys_core.grammar.model import Terminal, Verbatim
 
 __all__ = ["Drawing"]
 
 
 @dataclass(frozen=True, eq=False)
 class Drawing:
-    """A derived picture: terminal instances with their poses.
+    """A derived picture: terminal instances with their poses and styles, in paint order.
 
     Attributes
     ----------
@@ -28,6 +28,17 @@ class Drawing:
         Index of the rule whose production emitted the instance (-1: the axiom).
     viewbox, size
         The SVG canvas, as in :class:`~lsys_core.grammar.model.Grammar`.
+    styles : tuple of str
+        The distinct CSS styles of the instances (empty: each instance has its terminal's).
+    style : ndarray of int32, shape (n,), or None
+        Index of each instance's style in ``styles`` (None: its terminal's style).
+    defs : str
+        SVG markup the styles refer to by ``url(#id)``.
+    verbatim : tuple of Verbatim
+        Content drawn as is; ``order`` is the number of instances drawn before it.
+
+    Stroke widths and dashes in the styles are in canvas units, except for terminals whose
+    ``scaled`` flag is set (they scale with the instance, see :meth:`stroke_scale`).
     """
 
     terminals: tuple[Terminal, ...]
@@ -37,9 +48,32 @@ class Drawing:
     rule: np.ndarray
     viewbox: tuple[float, float, float, float] | None = None
     size: tuple[str, str] | None = None
+    styles: tuple[str, ...] = ()
+    style: np.ndarray | None = None
+    defs: str = ""
+    verbatim: tuple[Verbatim, ...] = ()
 
     def __len__(self) -> int:
         return int(self.symbol.size)
+
+    def instance_styles(self) -> tuple[tuple[str, ...], np.ndarray]:
+        """Return the distinct styles and each instance's index into them."""
+        if self.style is None:
+            return tuple(t.style for t in self.terminals), np.asarray(self.symbol, np.int32)
+        return self.styles, np.asarray(self.style, np.int32)
+
+    def stroke_scale(self) -> np.ndarray:
+        """Return, per instance, the factor from the styles' stroke widths to its local frame.
+
+        Widths are in canvas units, so an instance drawn at scale ``|a|`` strokes
+        ``width / |a|`` of its own units; a ``scaled`` terminal strokes ``width`` (factor 1).
+        """
+        scale = np.abs(np.asarray(self.a, complex))
+        scaled = np.array([t.scaled for t in self.terminals] + [True], bool)
+        sym = np.asarray(self.symbol, np.intp)
+        sym = np.where((sym >= 0) & (sym < len(self.terminals)), sym, len(self.terminals))
+        with np.errstate(divide="ignore"):
+            return np.where(scaled[sym] | (scale == 0), 1.0, 1.0 / np.where(scale == 0, 1.0, scale))
 
     def matrices(self) -> np.ndarray:
         """Return the ``(n, 3, 3)`` affine pose matrices."""

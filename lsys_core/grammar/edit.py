@@ -123,3 +123,31 @@ def _reachable(rules: list[Rule], axiom: tuple[Module, ...]) -> set[str]:
         for c in by_name[n].cases if n in by_name else ():
             todo.extend(m.name for m in c.body if isinstance(m, Symbol))
     return seen
+
+
+def rename_symbols(g: Grammar, names: dict[str, str]) -> Grammar:
+    """Return ``g`` with terminals and rules renamed by ``names`` (old -> new), uses included."""
+    if not names:
+        return g
+
+    def body(mods: tuple[Module, ...]) -> tuple[Module, ...]:
+        return tuple(
+            replace(m, name=names[m.name]) if isinstance(m, Symbol) and m.name in names else m for m in mods
+        )
+
+    terminals = tuple(
+        replace(
+            t,
+            name=names.get(t.name, t.name),
+            mirror_of=None if t.mirror_of is None else names.get(t.mirror_of, t.mirror_of),
+        )
+        for t in g.terminals
+    )
+    rules = tuple(
+        replace(
+            r, name=names.get(r.name, r.name), cases=tuple(replace(c, body=body(c.body)) for c in r.cases)
+        )
+        for r in g.rules
+    )
+    return replace(g, terminals=terminals, rules=rules, axiom=body(g.axiom))
+

@@ -2,19 +2,21 @@
 
 Modules
 -------
-``f(Δ)``, ``+(δ)``, ``-(δ)``, ``*(s)``
+``f(Δ)``, ``+(δ)``, ``-(δ)``, ``*(s)``, ``z(Δ)``
     :class:`Turtle` commands; their value is linear in the rule's counter ``m``:
-    ``t(m) = t0 + tΔ·m`` (:class:`Linear`).
+    ``t(m) = t0 + tΔ·m`` (:class:`Linear`).  ``z`` moves the turtle in paint order (later
+    terminals with a larger ``z`` are drawn on top).
 ``[`` ``]``
     :class:`Push` / :class:`Pop` of the turtle state.
 ``A``, ``P(m-1)``, ``Q(3)``
-    :class:`Symbol`: a terminal (draws its element at the turtle's pose) or a
-    non-terminal, which may take an integer counter argument ``k0 + k1·m``
-    (:class:`Count`).
+    :class:`Symbol`: a terminal (draws its element at the turtle's pose, optionally with a
+    :class:`Paint`: ``A{s2, opacity: 0.1*m}``) or a non-terminal, which may take an
+    integer counter argument ``k0 + k1·m`` (:class:`Count`).
 
 A :class:`Rule` rewrites one non-terminal; it has one or more :class:`Case` s with a
 condition ``m > 0``, ``m == 0`` or none.  A :class:`Grammar` holds terminals (their SVG
-path data and style, in their own local frame), rules and the axiom.
+path data and base style, in their own local frame), named styles, rules, the axiom, and
+optional per-instance tables (styles and paint order of the derived instances).
 """
 
 from __future__ import annotations
@@ -25,11 +27,14 @@ from typing import Final, Literal
 __all__ = [
     "COND_EQ0",
     "COND_GT0",
+    "PAINT_PROPS",
     "Case",
     "Count",
     "Grammar",
     "Linear",
     "Module",
+    "NamedStyle",
+    "Paint",
     "Pop",
     "Push",
     "Randomize",
@@ -45,9 +50,13 @@ COND_EQ0: Final = "m == 0"
 #: The condition of a case of a parametric rule.
 CaseCondition = Literal["m > 0", "m == 0"]
 Condition = CaseCondition | None
-TurtleOp = Literal["f", "+", "-", "*"]
+TurtleOp = Literal["f", "+", "-", "*", "z"]
 Jitter = Literal["cumulative", "instance"]
 JITTERS: tuple[Jitter, ...] = ("cumulative", "instance")
+
+#: Properties a :class:`Paint` may set to a value linear in ``m``: style numbers, ``hue``
+#: (turns the fill and stroke colours, degrees) and ``z`` (added to the paint-order value).
+PAINT_PROPS = ("opacity", "fill-opacity", "stroke-opacity", "stroke-width", "hue", "z")
 
 
 @dataclass(frozen=True)
@@ -68,7 +77,7 @@ class Count:
 
 @dataclass(frozen=True)
 class Turtle:
-    """A turtle command ``f``, ``+``, ``-`` or ``*`` with a value linear in ``m``."""
+    """A turtle command ``f``, ``+``, ``-``, ``*`` or ``z`` with a value linear in ``m``."""
 
     op: TurtleOp
     value: Linear
@@ -85,11 +94,27 @@ class Pop:
 
 
 @dataclass(frozen=True)
+class Paint:
+    """How one terminal occurrence is painted, over its terminal's base style.
+
+    ``style`` names a :class:`NamedStyle` whose declarations override the terminal's;
+    ``props`` set :data:`PAINT_PROPS` to values linear in the rule's counter (applied last).
+    """
+
+    style: str | None = None
+    props: tuple[tuple[str, Linear], ...] = ()
+
+
+@dataclass(frozen=True)
 class Symbol:
-    """A terminal or non-terminal symbol; ``arg`` is the counter passed to a parametric one."""
+    """A terminal or non-terminal symbol; ``arg`` is the counter passed to a parametric one.
+
+    ``paint`` (terminals only) overrides the terminal's style for this occurrence.
+    """
 
     name: str
     arg: Count | None = None
+    paint: Paint | None = None
 
 
 Module = Turtle | Push | Pop | Symbol
@@ -117,13 +142,24 @@ class Terminal:
     """A terminal symbol: an element's SVG path data and CSS style in its local frame.
 
     ``mirror_of`` names the terminal this one is a mirror image of (informative: the
-    path data already is the mirrored shape).
+    path data already is the mirrored shape).  Stroke widths and dashes of the style are in
+    canvas units whatever the instance's scale, unless ``scaled`` (format version 1's
+    meaning: they scale with the turtle).
     """
 
     name: str
     path: str
     style: str = ""
     mirror_of: str | None = None
+    scaled: bool = False
+
+
+@dataclass(frozen=True)
+class NamedStyle:
+    """A named set of CSS declarations, referenced by terminal occurrences (``A{s1}``)."""
+
+    name: str
+    css: str
 
 
 @dataclass(frozen=True)
@@ -184,8 +220,17 @@ class Grammar:
     #: SVG markup the terminals' and instances' styles refer to by ``url(#id)`` (gradients,
     #: patterns, clip paths, masks, filters, markers): written into the output's ``<defs>``.
     defs: str = ""
-    #: Content carried through verbatim, drawn at its place in the paint order.
+    #: Content carried through verbatim.  In a grammar, a verbatim item's ``order`` is the
+    #: number of derived instances (in paint order) drawn before it.
     verbatim: tuple[Verbatim, ...] = ()
+    #: Named styles that terminal occurrences refer to (``A{s1}``) and :attr:`paint` lists.
+    styles: tuple[NamedStyle, ...] = ()
+    #: Per-instance named style (``None``: as the rules paint it) of the derived instances,
+    #: in derivation order; instances past the end are painted as the rules say.
+    paint: tuple[str | None, ...] = ()
+    #: Per-instance paint-order offset added to the ``z`` of the derived instances, in
+    #: derivation order; instances past the end get 0.
+    order: tuple[float, ...] = ()
     #: The random perturbation the derivation applies (None: none).
     randomize: Randomize | None = None
 
@@ -194,6 +239,13 @@ class Grammar:
         for t in self.terminals:
             if t.name == name:
                 return t
+        return None
+
+    def style(self, name: str) -> NamedStyle | None:
+        """Return the named style called ``name``, or None."""
+        for s in self.styles:
+            if s.name == name:
+                return s
         return None
 
     def rule(self, name: str) -> Rule | None:

@@ -30,10 +30,12 @@ from lsys_core.errors import GrammarError
 from lsys_core.grammar.model import (
     COND_EQ0,
     COND_GT0,
+    PAINT_PROPS,
     Count,
     Grammar,
     Linear,
     Module,
+    Paint,
     Pop,
     Push,
     Rule,
@@ -44,8 +46,10 @@ from lsys_core.grammar.model import (
 __all__ = [
     "COUNT_LIMIT",
     "KEYWORDS",
+    "KEYWORDS_V1",
     "NAME_RE",
     "RESERVED",
+    "RESERVED_V1",
     "Problem",
     "count_text",
     "find_problems",
@@ -56,16 +60,23 @@ __all__ = [
 NAME_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 """Pattern of a symbol name."""
 
-KEYWORDS = frozenset({"lsys", "canvas", "viewbox", "size", "terminal", "style", "mirror", "axiom"})
+KEYWORDS_V1 = frozenset({"lsys", "canvas", "viewbox", "size", "terminal", "style", "mirror", "axiom"})
+"""Words of format version 1 that cannot name a symbol."""
+
+KEYWORDS = KEYWORDS_V1 | {"scaled", "paint", "order", "defs", "verbatim", "what"}
 """Words of the text format that cannot name a symbol."""
 
-RESERVED = KEYWORDS | {"f", "m", "eps", "nan", "inf", "infinity"}
-"""Every word that cannot name a symbol (keywords, the ``f`` module, the counter, ε, non-finite numbers)."""
+RESERVED_V1 = KEYWORDS_V1 | {"f", "m", "eps", "nan", "inf", "infinity"}
+"""The words format version 1 reserves."""
+
+RESERVED = KEYWORDS | RESERVED_V1 | {"z"}
+"""Every word that cannot name a symbol (keywords, the ``f`` and ``z`` modules, the counter, ε,
+non-finite numbers)."""
 
 COUNT_LIMIT = 2**31 - 1
 """Largest magnitude of a counter coefficient."""
 
-Where = Literal["grammar", "canvas", "terminal", "axiom", "rule"]
+Where = Literal["grammar", "canvas", "terminal", "axiom", "rule", "style", "table"]
 
 
 @dataclass(frozen=True)
@@ -78,7 +89,8 @@ class Problem:
         What is wrong, one line, without the location.
     where : str
         ``"rule"`` (``owner`` is the rule name), ``"axiom"``, ``"terminal"`` (``owner`` is
-        the terminal name), ``"canvas"`` or ``"grammar"`` (the whole grammar).
+        the terminal name), ``"style"`` (a named style), ``"table"`` (``owner`` is
+        ``"paint"``, ``"order"`` or ``"verbatim"``), ``"canvas"`` or ``"grammar"``.
     owner : str
         Rule or terminal name, ``"axiom"`` for the axiom, ``"viewbox"`` or ``"size"`` for
         the canvas, ``""`` for the whole grammar.
@@ -146,7 +158,10 @@ def find_problems(g: Grammar) -> list[Problem]:
     """
     problems = list(_name_problems(g))
     problems += _canvas_problems(g)
-    names = _Names({t.name for t in g.terminals}, {r.name: r.parametric for r in g.rules})
+    problems += _style_problems(g)
+    names = _Names(
+        {t.name for t in g.terminals}, {r.name: r.parametric for r in g.rules}, {s.name for s in g.styles}
+    )
     for r in g.rules:
         problems += _case_problems(r)
         for ci, case in enumerate(r.cases):
@@ -155,7 +170,9 @@ def find_problems(g: Grammar) -> list[Problem]:
         problems.append(Problem("missing axiom: add a line 'axiom: ...'", "grammar"))
     problems += _body_problems(names, g.axiom, "axiom", "axiom", 0, False)
     if not problems:  # the call graph is only meaningful for a well-formed grammar
-        problems += _termination_problems(g)
+        from lsys_core.grammar.termination import termination_problems
+
+        problems += termination_problems(g)
     return problems
 
 
@@ -165,6 +182,7 @@ class _Names:
 
     terminals: set[str]
     parametric: dict[str, bool]
+    styles: set[str]
 
 
 def _name_problems(g: Grammar) -> Iterator[Problem]:
@@ -213,6 +231,50 @@ def _canvas_problems(g: Grammar) -> list[Problem]:
     if g.size is not None and (len(g.size) != 2 or not all(isinstance(s, str) for s in g.size)):
         out.append(Problem("size needs two strings (width and height)", "canvas", "size"))
     return out
+
+
+def _style_problems(g: Grammar) -> list[Problem]:
+    """Return problems with named styles, the per-instance tables and the verbatim content."""
+    out = []
+    seen: set[str] = set()
+    for s in g.styles:
+        if not isinstance(s.name, str) or not NAME_RE.fullmatch(s.name) or s.name in RESERVED:
+            out.append(Problem(f"invalid style name {s.name!r}", "style", str(s.name)))
+        elif s.name in seen:
+            out.append(Problem(f"duplicate style '{s.name}'", "style", s.name))
+        if not isinstance(s.css, str):
+            out.append(Problem(f"style '{s.name}' needs a string of CSS declarations", "style", str(s.name)))
+        seen.add(s.name)
+    for name in dict.fromkeys(p for p in g.paint if p is not None):
+        if name not in seen:
+            out.append(Problem(f"paint: undefined style '{name}'", "table", name))
+    if not all(_finite(v) for v in g.order):
+        out.append(Problem("order: every entry must be a finite number", "table", "order"))
+    for v in g.verbatim:
+        if not _is_int(v.order) or v.order < 0 or not isinstance(v.xml, str):
+            out.append(Problem("verbatim: needs a whole number >= 0 and SVG markup", "table", "verbatim"))
+            break
+    return out
+
+
+def _paint_problem(names: _Names, paint: Paint, parametric: bool, no_m: str) -> str | None:
+    """Return what is wrong with a terminal occurrence's paint, or None."""
+    if not isinstance(paint, Paint):
+        return f"unknown paint {paint!r}"
+    if paint.style is not None and paint.style not in names.styles:
+        return f"undefined style '{paint.style}': declare it with a line 'style {paint.style} \"...\"'"
+    seen = set()
+    for key, v in paint.props:
+        if key not in PAINT_PROPS:
+            return f"unknown paint property '{key}' (known: {', '.join(PAINT_PROPS)})"
+        if key in seen:
+            return f"duplicate paint property '{key}'"
+        seen.add(key)
+        if not isinstance(v, Linear) or not (_finite(v.c0) and _finite(v.cd)):
+            return f"the value of '{key}' must be a finite number"
+        if v.cd != 0 and not parametric:
+            return no_m
+    return None
 
 
 def _case_problems(r: Rule) -> list[Problem]:
@@ -273,7 +335,7 @@ def _body_problems(
 
 def _turtle_problem(mod: Turtle, parametric: bool, no_m: str) -> str | None:
     """Return what is wrong with a turtle module, or None."""
-    if mod.op not in ("f", "+", "-", "*"):
+    if mod.op not in ("f", "+", "-", "*", "z"):
         return f"unknown turtle command {mod.op!r}"
     v = mod.value
     if not isinstance(v, Linear) or not (_finite(v.c0) and _finite(v.cd)):
@@ -289,7 +351,13 @@ def _symbol_problem(names: _Names, mod: Symbol, parametric: bool, no_m: str) -> 
     """Return what is wrong with a symbol module and whether it is the argument, or None."""
     name = mod.name
     if name in names.terminals:
-        return (f"terminal {name} takes no argument", False) if mod.arg is not None else None
+        if mod.arg is not None:
+            return f"terminal {name} takes no argument", False
+        if mod.paint is not None and (msg := _paint_problem(names, mod.paint, parametric, no_m)):
+            return msg, True
+        return None
+    if mod.paint is not None:
+        return f"{name} is not a terminal: only terminals take a paint {{...}}", False
     parametric_rule = names.parametric.get(name)
     if parametric_rule is None:
         return f"undefined symbol '{name}': declare it as a terminal or give it a rule", False
@@ -306,91 +374,6 @@ def _symbol_problem(names: _Names, mod: Symbol, parametric: bool, no_m: str) -> 
         return f"counter argument of {name} is out of range (|k| <= {COUNT_LIMIT})", True
     if a.k1 != 0 and not parametric:
         return no_m, True
-    return None
-
-
-def _termination_problems(g: Grammar) -> list[Problem]:
-    """Return a problem for every call that lets a derivation loop forever."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    index = {r.name: i for i, r in enumerate(g.rules)}
-    calls = [
-        (index[r.name], index[mod.name], r, ci, mi, mod)
-        for r in g.rules
-        for ci, case in enumerate(r.cases)
-        for mi, mod in enumerate(case.body)
-        if isinstance(mod, Symbol) and mod.name in index
-    ]
-    if not calls:
-        return []
-
-    def scc(edges: list[tuple[int, int]]) -> np.ndarray:
-        src, dst = np.array(edges, dtype=int).T
-        mat = coo_matrix((np.ones(len(edges)), (src, dst)), shape=(len(index), len(index)))
-        return connected_components(mat, directed=True, connection="strong")[1]
-
-    def cyclic(labels: np.ndarray, edges: list[tuple[int, int]]) -> list[bool]:
-        """Tell for each edge whether it lies on a cycle (same SCC, or a self-loop)."""
-        sizes = np.bincount(labels, minlength=len(index))
-        return [labels[u] == labels[v] and (u == v or sizes[labels[u]] > 1) for u, v in edges]
-
-    edges = [(u, v) for u, v, *_ in calls]
-    out = []
-    zero_calls = []
-    for on_cycle, c in zip(cyclic(scc(edges), edges), calls, strict=True):
-        _, _, r, ci, mi, mod = c
-        if not on_cycle:
-            continue
-        arg = mod.arg
-        call = mod.name + (f"({count_text(arg)})" if arg is not None else "")
-        if arg is None:  # well-formed: a call passes a counter exactly when its rule is parametric
-            why = f"the call {call} closes a cycle that has no counter to stop it"
-        elif arg.k1 != 1 or arg.k0 > 0:
-            why = f"the call {call} does not decrease m (write {mod.name}(m-1))"
-        else:
-            if arg.k0 == 0:
-                zero_calls.append(c)
-            continue
-        out.append(Problem(f"rule {r.name} never terminates: {why}", "rule", r.name, ci, mi))
-    if zero_calls:  # m - 0 is fine only if every cycle through it also has a decreasing call
-        zedges = [(u, v) for u, v, *_ in zero_calls]
-        for on_cycle, (_, _, r, ci, mi, mod) in zip(cyclic(scc(zedges), zedges), zero_calls, strict=True):
-            if on_cycle:
-                why = f"the call {mod.name}(m) does not decrease m (write {mod.name}(m-1))"
-                out.append(Problem(f"rule {r.name} never terminates: {why}", "rule", r.name, ci, mi))
-    return out
-
-
-def path_problem(d: str) -> str | None:
-    """Return why terminal path data cannot be drawn, or None.
-
-    Not part of :func:`find_problems`: path data is kept as given, and only a caller that
-    is about to draw or export (the ``lsys`` command) insists that it parses.
-
-    Parameters
-    ----------
-    d : str
-        SVG path data; empty data (a terminal that draws nothing) is fine.
-
-    Returns
-    -------
-    str or None
-        ``"invalid path data ..."`` or ``"path data has non-finite or huge coordinates"``.
-    """
-    from lsys_core.errors import SvgError
-    from lsys_core.geometry.paths import MAX_COORD
-    from lsys_core.geometry.shapes import shape_arrays
-
-    if not d.strip():
-        return None
-    try:
-        cubics, _, _ = shape_arrays(d)
-    except SvgError as exc:
-        return str(exc)
-    with np.errstate(invalid="ignore"):
-        if cubics.size and not (np.isfinite(cubics).all() and np.abs(cubics).max() <= MAX_COORD):
-            return "path data has non-finite or huge coordinates"
     return None
 
 
@@ -413,3 +396,10 @@ def _finite(x: object) -> bool:
 def _is_int(x: object) -> bool:
     """Tell whether ``x`` is an integer (Python or numpy), not a bool."""
     return isinstance(x, int | np.integer) and not isinstance(x, bool)
+
+
+def path_problem(d: str) -> str | None:
+    """Return why terminal path data cannot be drawn, or None (see :mod:`.termination`)."""
+    from lsys_core.grammar.termination import path_problem as check
+
+    return check(d)

@@ -40,9 +40,18 @@ _STAGE = "similarity"
 
 
 def terminal_name(index: int) -> str:
-    """Return the name of the ``index``-th terminal: ``A`` … ``Z``, then ``A1`` … ``Z1``, ``A2`` …."""
-    letter = chr(ord("A") + index % 26)
-    return letter if index < 26 else f"{letter}{index // 26}"
+    """Return the name of the ``index``-th terminal: ``A`` … ``Z``, ``AA`` … ``ZZ``, ``AAA`` ….
+
+    Terminal names are capital letters only; rule names carry a digit (``P1``), so the two
+    never meet, and the hierarchy's catch-all rule ``Z`` takes another name when a terminal
+    is called ``Z`` (see ``SymbolTable.new_name``).
+    """
+    name = ""
+    index += 1
+    while index > 0:
+        index, r = divmod(index - 1, 26)
+        name = chr(ord("A") + r) + name
+    return name
 
 
 def _path_data(element: Element, origin: complex) -> str:
@@ -54,18 +63,12 @@ def _path_data(element: Element, origin: complex) -> str:
 
 
 def _style_key(style: str) -> str:
-    """Return the style's declarations in a canonical order, without the stroke width.
+    """Return the key elements are grouped by: none, a terminal is geometry only.
 
-    The stroke width does not split groups: tools scale it with the shape or not, so
-    copies of one shape carry all sorts of widths; the terminal keeps the representative's.
+    Styles travel with the instances (the pipeline gives every placed instance its own
+    fill, stroke, widths and opacity), so shapes that differ only in style are one terminal.
     """
-    decls: dict[str, str] = {}
-    for part in style.split(";"):
-        key, sep, value = part.partition(":")
-        if sep:
-            decls[key.strip().lower()] = value.strip()
-    decls.pop("stroke-width", None)
-    return ";".join(f"{k}:{v}" for k, v in sorted(decls.items()))
+    return ""
 
 
 def _rotate_residuals(probe, dense, normals, tree: cKDTree, angles: np.ndarray, tol: float) -> np.ndarray:

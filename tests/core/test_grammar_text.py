@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -14,6 +16,8 @@ from lsys_core.grammar import (
     Count,
     Grammar,
     Linear,
+    NamedStyle,
+    Paint,
     Pop,
     Push,
     Rule,
@@ -102,7 +106,8 @@ def test_paper_fig1_branching_parses_with_nested_brackets():
 def test_reference_example_parses_in_full():
     g = parse_grammar(BRIEF_EXAMPLE)
     assert g.viewbox == (0, 0, 800, 600) and g.size == ("800", "600")
-    assert g.terminal("B") == Terminal("B", "M 0 0 L 10 0", "stroke:#f00", "A")
+    # a version-1 file: strokes scale with the turtle, as that version drew them
+    assert g.terminal("B") == Terminal("B", "M 0 0 L 10 0", "stroke:#f00", "A", scaled=True)
     assert [r.name for r in g.rules] == ["P", "R", "Q", "X", "Y", "E"]
     assert g.rule("Q").cases[0].body[1] == t(10, 2, op="+")
     assert g.rule("X") == Rule("X", False, (Case(None, (Symbol("A"), t(10), Symbol("B"))),))
@@ -222,7 +227,7 @@ def test_format_writes_the_canonical_layout():
         size=("8cm", "6cm"),
     )
     assert format_grammar(g) == (
-        "lsys 1\n"
+        "lsys 2\n"
         'canvas viewbox 0 -1.5 800 600 size "8cm" "6cm"\n'
         'terminal A "M 0 0 \\"q\\"" style "fill:red"\n'
         'terminal B "M 1 1" mirror A\n'
@@ -236,7 +241,7 @@ def test_formatting_hand_written_text_is_a_fixed_point():
     once = format_grammar(parse_grammar(BRIEF_EXAMPLE))
     assert once != BRIEF_EXAMPLE
     assert format_grammar(parse_grammar(once)) == once
-    assert once.startswith("lsys 1\n# comments run from")
+    assert once.startswith("lsys 1\n# comments run from")  # nothing of version 2: still version 1
 
 
 # -- random grammars ------------------------------------------------------------------------------
@@ -498,8 +503,28 @@ def test_examples_in_the_format_documentation_parse():
 
     doc = (Path(__file__).parents[2] / "docs" / "lsys-format.md").read_text(encoding="utf-8")
     blocks = [b.split("```", 1)[0] for b in doc.split("```text\n")[1:]]
-    examples = [b for b in blocks if b.startswith("lsys 1")]
+    examples = [b for b in blocks if b.startswith("lsys ")]
     assert len(examples) >= 3
     for text in examples:
         g = parse_grammar(text)
         assert parse_grammar(format_grammar(g)) == g
+
+
+# -- versions -------------------------------------------------------------------------------------
+
+
+def test_a_grammar_is_written_in_the_oldest_version_that_holds_it():
+    v1 = parse_grammar('lsys 1\nterminal z "M 0 0 L 1 0" style "stroke:#000"\naxiom: z f(2) z\n')
+    # read as drawn: the terminal's strokes scale (version 1), 'z' (a version-2 module) is renamed
+    assert v1.terminals == (Terminal("z_", "M 0 0 L 1 0", "stroke:#000", scaled=True),)
+    text = format_grammar(v1)
+    assert text.startswith("lsys 1\n") and " scaled" not in text
+    assert parse_grammar(text) == v1
+    # anything of version 2 makes it version 2, and the terminal keeps its meaning there
+    painted = replace(v1, axiom=(Symbol("z_", paint=Paint(props=(("opacity", Linear(0.5)),))),))
+    for g in (painted, replace(v1, styles=(NamedStyle("s1", "fill:red"),)), replace(v1, order=(1.0,))):
+        text = format_grammar(g)
+        assert text.startswith("lsys 2\n") and 'terminal z_ "M 0 0 L 1 0" style "stroke:#000" scaled' in text
+        assert parse_grammar(text) == g
+    unscaled = replace(v1, terminals=(replace(v1.terminals[0], scaled=False),))
+    assert format_grammar(unscaled).startswith("lsys 2\n")

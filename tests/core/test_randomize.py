@@ -22,7 +22,10 @@ def test_randomize_line_round_trips_and_needs_version_2():
     assert parse_grammar(text) == g
     plain = parse_grammar("lsys 1\n" + ROW)
     assert plain.randomize is None and format_grammar(plain).startswith("lsys 1\n")  # old files stay v1
-    assert format_grammar(dataclasses.replace(plain, randomize=g.randomize)) == text
+    # randomized, it needs version 2, where its terminal keeps version 1's strokes ('scaled')
+    again = format_grammar(dataclasses.replace(plain, randomize=g.randomize))
+    assert again == text.replace('terminal A "M 0 0 L 1 0"', 'terminal A "M 0 0 L 1 0" scaled')
+    assert parse_grammar(again) == dataclasses.replace(plain, randomize=g.randomize)
 
 
 @pytest.mark.parametrize(

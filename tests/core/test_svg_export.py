@@ -150,7 +150,7 @@ def test_exported_instances_reimport_at_their_poses():
         expected = a[i] * local[symbol[i]] + b[i]
         assert np.abs(el.cubics - expected).max() < 1e-5 * (1 + np.abs(b[i]))
         width = float(dict(p.split(":") for p in el.style.split(";"))["stroke-width"])
-        assert width == pytest.approx((1.0, 0.5)[symbol[i]] * abs(a[i]), rel=1e-5)
+        assert width == pytest.approx((1.0, 0.5)[symbol[i]], rel=1e-5)  # canvas units at every scale
 
 
 def test_round_trip_corpus_and_realworld(shared):
@@ -185,7 +185,9 @@ def test_viewbox_computed_from_bounds():
 
 def test_bounds_include_stroke():
     line = Terminal("L", "M0 0 L10 0", "fill:none;stroke:#000;stroke-width:2")
-    assert drawing_bounds(drawing_of([line], [0], [3], [0])) == pytest.approx((-3, -3, 33, 3))
+    assert drawing_bounds(drawing_of([line], [0], [3], [0])) == pytest.approx((-1, -1, 31, 1))
+    scaled = Terminal("L", "M0 0 L10 0", "fill:none;stroke:#000;stroke-width:2", scaled=True)
+    assert drawing_bounds(drawing_of([scaled], [0], [3], [0])) == pytest.approx((-3, -3, 33, 3))
 
 
 def test_empty_drawing():

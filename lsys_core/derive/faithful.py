@@ -1,0 +1,289 @@
+"""Make an inferred grammar paint like its input: paint order, per-instance styles, names.
+
+The hierarchy writes rules for the geometry only.  Here the grammar is derived once, each
+derived instance is matched to the input element it reproduces, and the grammar is given
+what the elements' paint needs:
+
+- **styles** — every terminal occurrence whose instances share one style gets it
+  (``A{s2}``, nothing when it is the terminal's own base style); when the instances differ
+  only in numbers linear in the rule's counter (opacity fading, stroke width growing), the
+  numbers become paint properties (``A{opacity: 0.1 + 0.07*m}``); any other instance keeps its
+  own style through the ``paint:`` table;
+- **paint order** — when the derived order differs from the document's, each occurrence
+  whose instances' document positions are linear in the counter gets a paint-order value
+  (``A{z: 4 + 2*m}``), and if that still does not give the document order, the ``order:``
+  table lists every instance's place.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from lsys_core.derive.derivation import Trace
+from lsys_core.derive.paint import css_decls, css_text
+from lsys_core.grammar.model import Grammar, Linear, Module, NamedStyle, Paint, Symbol
+
+__all__ = ["fit_paint", "match_instances"]
+
+#: Style properties whose numbers may progress linearly along a rule (become paint properties).
+_NUMERIC = ("opacity", "fill-opacity", "stroke-opacity", "stroke-width")
+#: Largest exact assignment problem solved per terminal; larger groups match greedily.
+_ASSIGN_LIMIT = 1500
+
+
+def match_instances(
+    drawing_names: list[str],
+    symbol: np.ndarray,
+    a: np.ndarray,
+    b: np.ndarray,
+    element_names: list[str],
+    ea,
+    eb,
+) -> np.ndarray | None:
+    """Return, for every derived instance, the index of the input element it reproduces.
+
+    Instances and elements are matched terminal by terminal (by name) on their poses; None
+    when the counts of some terminal differ (the grammar does not reproduce the input).
+    """
+    out = np.full(symbol.size, -1, np.int64)
+    inst_name = np.asarray(drawing_names, dtype=object)[symbol] if symbol.size else np.zeros(0, object)
+    el_name = np.asarray(element_names, dtype=object)
+    if inst_name.size != el_name.size:
+        return None
+    scale = max(float(np.ptp(np.concatenate([eb.real, eb.imag]))) if eb.size else 1.0, 1e-12)
+    for name in set(element_names):
+        mine = np.flatnonzero(el_name == name)
+        theirs = np.flatnonzero(inst_name == name)
+        if mine.size != theirs.size:
+            return None
+        if mine.size <= _ASSIGN_LIMIT:
+            from scipy.optimize import linear_sum_assignment
+
+            cost = np.abs(eb[mine][:, None] - b[theirs][None, :]) + scale * 1e-3 * np.abs(
+                ea[mine][:, None] - a[theirs][None, :]
+            )
+            rows, cols = linear_sum_assignment(cost)
+            out[theirs[cols]] = mine[rows]
+        else:
+            out[theirs] = _greedy(eb[mine], b[theirs], mine)
+    return out
+
+
+def _greedy(target: np.ndarray, found: np.ndarray, ids: np.ndarray) -> np.ndarray:
+    """Match points ``found`` to ``target`` one to one, nearest pairs first (ids of the targets)."""
+    from scipy.spatial import cKDTree
+
+    k = min(8, target.size)
+    dist, near = cKDTree(np.column_stack([target.real, target.imag])).query(
+        np.column_stack([found.real, found.imag]), k=k
+    )
+    dist, near = dist.reshape(found.size, k), near.reshape(found.size, k)
+    order = np.argsort(dist, axis=None, kind="stable")
+    result = np.full(found.size, -1, np.int64)
+    taken = np.zeros(target.size, bool)
+    for flat in order.tolist():
+        i, j = divmod(flat, k)
+        t = near[i, j]
+        if result[i] < 0 and not taken[t]:
+            result[i], taken[t] = t, True
+    rest = np.flatnonzero(result < 0)
+    result[rest] = np.flatnonzero(~taken)[: rest.size]
+    return ids[result]
+
+
+def fit_paint(
+    g: Grammar, element_styles: list[str], element_order: np.ndarray, match: np.ndarray, trace: Trace
+) -> Grammar:
+    """Return ``g`` with styles and paint order that reproduce the matched elements'.
+
+    Parameters
+    ----------
+    g : Grammar
+        A grammar without paints or tables, whose derivation gave ``trace``.
+    element_styles : list of str
+        Resolved style of every input element.
+    element_order : ndarray
+        Paint-order key of every input element (document order).
+    match : ndarray of int
+        Element index of every derived instance (in the trace's order).
+    trace : Trace
+        The derivation's trace.
+    """
+    styles = np.asarray(element_styles, dtype=object)[match]
+    order = np.asarray(element_order, float)[match]
+    edits: dict[tuple[str, int, int], dict] = {}
+    g, table = _fit_styles(g, styles, trace, edits)
+    g, z_table = _fit_order(g, order, trace, edits)
+    g = _apply(g, edits)
+    if table is not None:
+        g = replace(g, paint=table)
+    if z_table is not None:
+        g = replace(g, order=z_table)
+    return g
+
+
+def _named(names: dict[str, str], css: str) -> str:
+    """Return the name of the named style with declarations ``css`` (made if new)."""
+    if css not in names:
+        names[css] = f"s{len(names) + 1}"
+    return names[css]
+
+
+def _fit_styles(g: Grammar, styles: np.ndarray, trace: Trace, edits: dict) -> tuple[Grammar, tuple | None]:
+    """Choose base styles, occurrence paints and a ``paint:`` table; record paints in ``edits``."""
+    n = styles.size
+    if n == 0:
+        return g, None
+    slot_terms = {}
+    for s in np.unique(trace.slot).tolist():
+        owner, ci, mi = trace.slots[s]
+        slot_terms[s] = _module(g, owner, ci, mi).name
+    # Base style of each terminal: the most common among its instances.
+    base = {}
+    for t in g.terminals:
+        mine = [i for i, s in enumerate(trace.slot.tolist()) if slot_terms[s] == t.name]
+        if mine:
+            vals, counts = np.unique(styles[mine].astype(str), return_counts=True)
+            base[t.name] = str(vals[np.argmax(counts)])
+    g = replace(g, terminals=tuple(replace(t, style=base.get(t.name, t.style)) for t in g.terminals))
+    names: dict[str, str] = {}
+    table: list[str | None] = [None] * n
+    need_table = False
+    for s, term in slot_terms.items():
+        sel = np.flatnonzero(trace.slot == s)
+        own = base.get(term, "")
+        distinct = list(dict.fromkeys(str(v) for v in styles[sel].tolist()))
+        if len(distinct) == 1:
+            if distinct[0] != own:
+                edits.setdefault(trace.slots[s], {})["style"] = _named(names, distinct[0])
+            continue
+        fitted = _linear_props(styles[sel].tolist(), trace.m[sel])
+        if fitted is not None:
+            common, props = fitted
+            entry = edits.setdefault(trace.slots[s], {})
+            if common != own:
+                entry["style"] = _named(names, common)
+            entry["props"] = props
+            continue
+        need_table = True
+        for i in sel.tolist():
+            if styles[i] != own:
+                table[int(trace.position[i])] = _named(names, styles[i])
+    named = tuple(NamedStyle(name, css) for css, name in names.items())
+    g = replace(g, styles=named)
+    if not need_table:
+        return g, None
+    while table and table[-1] is None:
+        table.pop()
+    return g, tuple(table)
+
+
+def _linear_props(styles: list[str], m: np.ndarray) -> tuple[str, list[tuple[str, Linear]]] | None:
+    """Return the shared declarations and the numeric ones linear in ``m``, or None."""
+    decls = [css_decls(s) for s in styles]
+    keys = set(decls[0])
+    if any(set(d) != keys for d in decls):
+        return None
+    varying = [k for k in keys if len({d[k] for d in decls}) > 1]
+    if not varying or any(k not in _NUMERIC for k in varying):
+        return None
+    props = []
+    mm = m.astype(float)
+    if np.ptp(mm) == 0:
+        return None
+    for k in sorted(varying, key=_NUMERIC.index):
+        try:
+            v = np.array([float(d[k]) for d in decls])
+        except ValueError:
+            return None
+        cd, c0 = np.polyfit(mm, v, 1)
+        fit = c0 + cd * mm
+        if np.abs(fit - v).max() > 1e-6 * max(1.0, float(np.abs(v).max())) + 5e-7:
+            return None
+        props.append((k, Linear(_round(c0), _round(cd))))
+    common = dict(decls[0])
+    for k in varying:
+        common.pop(k)
+    return css_text(common), props
+
+
+def _round(x: float) -> float:
+    """Round to 9 significant digits (a fit of 6-digit style numbers)."""
+    return float(f"{x:.9g}") + 0.0
+
+
+def _fit_order(g: Grammar, order: np.ndarray, trace: Trace, edits: dict) -> tuple[Grammar, tuple | None]:
+    """Give occurrences ``z`` values, or an ``order:`` table, so instances paint in document order."""
+    n = order.size
+    if n < 2 or np.all(np.diff(order) >= 0):  # the derivation already paints in document order
+        return g, None
+    # Per occurrence: document order linear in the counter?
+    zs = np.zeros(n)
+    fits: dict[int, tuple[float, float]] | None = {}
+    for s in np.unique(trace.slot).tolist():
+        sel = np.flatnonzero(trace.slot == s)
+        mm = trace.m[sel].astype(float)
+        target = order[sel]
+        if sel.size == 1 or np.ptp(mm) == 0:
+            if np.ptp(target) > 0:
+                fits = None
+                break
+            c0, cd = float(target[0]), 0.0
+        else:
+            if np.unique(mm).size != mm.size:
+                fits = None
+                break
+            cd, c0 = np.polyfit(mm, target, 1)
+            c0, cd = _round(c0), _round(cd)
+        zs[sel] = c0 + cd * mm
+        assert fits is not None
+        fits[s] = (c0, cd)
+    if fits is not None:
+        by_z = np.lexsort((trace.position, zs))
+        if np.all(np.diff(order[by_z]) >= 0):
+            for s, (c0, cd) in fits.items():
+                edits.setdefault(trace.slots[s], {})["z"] = Linear(c0, cd)
+            return g, None
+    table = np.zeros(n)
+    table[trace.position] = order
+    return g, tuple(float(v) for v in table)
+
+
+def _module(g: Grammar, owner: str, ci: int, mi: int) -> Symbol:
+    """Return the terminal occurrence at ``(owner, case, module index)``."""
+    rule = g.rule(owner)
+    body = g.axiom if owner == "axiom" or rule is None else rule.cases[ci].body
+    mod = body[mi]
+    assert isinstance(mod, Symbol)
+    return mod
+
+
+def _apply(g: Grammar, edits: dict) -> Grammar:
+    """Write the recorded paints (style, properties) and ``z`` values into the bodies.
+
+    A paint-order value is the occurrence's paint property ``z`` (``A{z: 4 + 2*m}``).
+    """
+    if not edits:
+        return g
+
+    def body(owner: str, ci: int, mods: tuple[Module, ...]) -> tuple[Module, ...]:
+        out = list(mods)
+        for (o, c, mi), e in edits.items():
+            if o != owner or c != ci:
+                continue
+            mod = out[mi]
+            props = list(e.get("props", ()))
+            if "z" in e and (e["z"].c0 != 0 or e["z"].cd != 0):
+                props.append(("z", e["z"]))
+            if e.get("style") is None and not props:
+                continue
+            out[mi] = replace(mod, paint=Paint(e.get("style"), tuple(props)))
+        return tuple(out)
+
+    rules = tuple(
+        replace(r, cases=tuple(replace(c, body=body(r.name, ci, c.body)) for ci, c in enumerate(r.cases)))
+        for r in g.rules
+    )
+    return replace(g, rules=rules, axiom=body("axiom", 0, g.axiom))

@@ -1,0 +1,208 @@
+"""Faithful output: paint order, strokes, per-instance styles, parameters, defs and verbatim content.
+
+Pictures are compared by rendering the input's elements and the derived drawing with the
+project's renderer (the paint of every pixel shows stacking order, colours and stroke widths).
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from lsys_core.derive.derivation import derive
+from lsys_core.derive.model import Drawing
+from lsys_core.geometry.paths import d_from_cubics
+from lsys_core.grammar import format_grammar, parse_grammar
+from lsys_core.grammar.model import Terminal, Verbatim
+from lsys_core.pipeline import infer
+from lsys_core.render.raster import render
+from lsys_core.render.svg import drawing_to_svg
+from lsys_core.svg.model import Element, Scene
+from lsys_core.svg.parse import parse_svg
+
+K = 0.5523  # cubic circle constant
+
+
+def circle(center: complex, r: float) -> np.ndarray:
+    """A closed circle of four cubics."""
+    pts = [1, 1j, -1, -1j, 1]
+    return np.array(
+        [
+            [center + r * p, center + r * (p + K * 1j * p), center + r * (q - K * 1j * q), center + r * q]
+            for p, q in itertools.pairwise(pts)
+        ]
+    )
+
+
+def square(center: complex, side: float, turn: float = 0.0) -> np.ndarray:
+    corners = center + side / 2 * np.exp(1j * (np.pi / 4 + turn + np.arange(5) * np.pi / 2)) * np.sqrt(2)
+    p, q = corners[:-1], corners[1:]
+    return np.stack([p, p + (q - p) / 3, p + 2 * (q - p) / 3, q], axis=1)
+
+
+def element(cubics: np.ndarray, style: str, order: int = -1) -> Element:
+    return Element(cubics, np.zeros(len(cubics), int), (True,), style, "", order)
+
+
+def input_drawing(scene: Scene, viewbox) -> Drawing:
+    """The scene's elements as a drawing: one terminal per element at the identity pose, in document order."""
+    els = sorted(enumerate(scene.elements), key=lambda p: p[1].order if p[1].order >= 0 else p[0])
+    terms = tuple(
+        Terminal(f"E{i}", d_from_cubics(e.cubics, e.subpaths, e.closed), e.style)
+        for i, (_, e) in enumerate(els)
+    )
+    n = len(terms)
+    return Drawing(
+        terms,
+        np.arange(n, dtype=np.int32),
+        np.ones(n, complex),
+        np.zeros(n, complex),
+        np.full(n, -1, np.int32),
+        viewbox,
+        None,
+    )
+
+
+def round_trip(scene: Scene) -> tuple[Drawing, str]:
+    """Infer, write the rules as text, read them back and derive."""
+    text = format_grammar(infer(scene).grammar)
+    return derive(parse_grammar(text)), text
+
+
+def differing(a: np.ndarray, b: np.ndarray) -> float:
+    """Share of inked pixels whose colour differs by more than 48 levels."""
+    ink = (a[..., 3] > 0) | (b[..., 3] > 0)
+    diff = np.abs(a.astype(int) - b.astype(int)).max(axis=2) > 48
+    return float((diff & ink).sum()) / max(int(ink.sum()), 1)
+
+
+def assert_same_picture(scene: Scene, out: Drawing, viewbox, limit: float = 0.01) -> None:
+    ref = render(input_drawing(scene, viewbox), 200, 200, view=viewbox, background=(255, 255, 255, 255))
+    got = render(out, 200, 200, view=viewbox, background=(255, 255, 255, 255))
+    assert differing(ref, got) <= limit
+
+
+def test_overlapping_shapes_keep_their_stacking_order() -> None:
+    # Five overlapping discs in a row, drawn right to left in the document (each partly under
+    # the next): the inferred sequence runs left to right, so its derivation order is reversed.
+    colours = ["#d00", "#0a0", "#00d", "#aa0", "#0aa"]
+    els = [
+        element(circle(complex(20 + 12 * i, 50), 10), f"fill:{colours[i]};stroke:none", order=4 - i)
+        for i in range(5)
+    ]
+    scene = Scene(tuple(els))
+    out, _ = round_trip(scene)
+    vb = (0, 20, 100, 60)
+    assert_same_picture(scene, out, vb)
+    # the front disc is the leftmost one: at its right edge the next disc is underneath
+    pixels = render(out, 100, 60, view=vb)
+    assert tuple(pixels[30, 27, :3]) == (0xDD, 0, 0)
+
+
+def test_stroke_width_stays_as_drawn_on_a_shape_reused_at_three_scales() -> None:
+    els = [
+        element(circle(complex(x, 50), r), "fill:none;stroke:#000;stroke-width:2")
+        for x, r in ((20, 5), (50, 10), (90, 20))
+    ]
+    scene = Scene(tuple(els))
+    result = infer(scene)
+    assert len(result.grammar.terminals) == 1
+    out = derive(parse_grammar(format_grammar(result.grammar)))
+    back = parse_svg(drawing_to_svg(out))
+    widths = [float(dict(p.split(":") for p in e.style.split(";"))["stroke-width"]) for e in back.elements]
+    assert widths == pytest.approx([2, 2, 2], rel=1e-5)
+    assert_same_picture(scene, out, (0, 20, 120, 60))
+
+
+def test_shapes_differing_only_in_style_are_one_terminal() -> None:
+    styles = ["fill:#e41a1c", "fill:#377eb8;stroke:#000;stroke-width:1.5", "fill:#4daf4a;opacity:0.5"]
+    els = [element(square(complex(15 + 20 * i, 30), 12), styles[(i * 7) % 3]) for i in range(9)]
+    scene = Scene(tuple(els))
+    out, text = round_trip(scene)
+    assert text.count("\nterminal ") == 1
+    back = parse_svg(drawing_to_svg(out))
+    got = sorted((round(e.cubics[0, 0].real), e.style) for e in back.elements)
+    want = sorted((round(e.cubics[0, 0].real), e.style) for e in els)
+    assert [g[0] for g in got] == [w[0] for w in want]
+    assert_same_picture(scene, out, (0, 0, 200, 60))
+
+
+def test_an_opacity_progression_is_one_rule_with_a_parameter() -> None:
+    # a spinner: twelve bars around a centre, each a little more transparent
+    bars = []
+    for k in range(12):
+        turn = k * np.pi / 6
+        centre = 50 + 50j + 30 * np.exp(1j * turn)
+        bar = np.array([-8 - 2j, 8 - 2j, 8 + 2j, -8 + 2j, -8 - 2j])
+        pts = centre + bar * np.exp(1j * turn)
+        p, q = pts[:-1], pts[1:]
+        cubics = np.stack([p, p + (q - p) / 3, p + 2 * (q - p) / 3, q], axis=1)
+        bars.append(element(cubics, f"fill:#333;opacity:{1 - k / 12:.6g}"))
+    scene = Scene(tuple(bars))
+    out, text = round_trip(scene)
+    g = parse_grammar(text)
+    assert g.production_count <= 2
+    props = [
+        p
+        for r in g.rules
+        for c in r.cases
+        for mod in c.body
+        if getattr(mod, "paint", None)
+        for p in mod.paint.props
+    ]
+    assert any(k == "opacity" and v.cd != 0 for k, v in props)
+    assert "paint:" not in text
+    assert_same_picture(scene, out, (0, 0, 100, 100))
+
+
+def test_colours_without_a_pattern_keep_one_terminal_and_a_paint_table() -> None:
+    rng = np.random.default_rng(3)
+    cols = [f"fill:#{int(v):06x}" for v in rng.integers(0, 0xFFFFFF, 40)]
+    els = [element(square(complex(10 + 12 * (i % 8), 10 + 12 * (i // 8)), 10), cols[i]) for i in range(40)]
+    scene = Scene(tuple(els))
+    out, text = round_trip(scene)
+    assert text.count("\nterminal ") == 1
+    assert_same_picture(scene, out, (0, 0, 110, 70))
+
+
+def test_defs_and_verbatim_content_are_carried_through() -> None:
+    els = [
+        element(square(complex(20 + 25 * i, 30), 20), "fill:url(#g);stroke:none", order=2 * i)
+        for i in range(3)
+    ]
+    text_xml = '<text x="10" y="80" font-size="12">Hello %s</text>'
+    scene = Scene(
+        tuple(els),
+        viewbox=(0, 0, 100, 100),
+        defs='<linearGradient id="g"><stop offset="0" stop-color="#f00"/><stop offset="1" stop-color="#00f"/></linearGradient>',
+        verbatim=(Verbatim(3, text_xml, "<text> 'Hello %s'"),),
+    )
+    g = parse_grammar(format_grammar(infer(scene).grammar))
+    assert g.verbatim == (Verbatim(2, text_xml, "<text> 'Hello %s'"),)
+    svg = drawing_to_svg(derive(g))
+    assert '<linearGradient id="g">' in svg.split("</defs>")[0]
+    body = svg.split("</defs>")[1]
+    # the text is drawn after the first two squares and before the third
+    assert body.index(text_xml) > body.index("<path", body.index("<path") + 1)
+    assert body.index(text_xml) < body.rindex("<path")
+    # instances painted with a gradient are written in canvas coordinates
+    assert body.count("url(#g)") == 3 and "transform" not in body
+
+
+@pytest.mark.slow
+def test_a_thousand_distinct_shapes_get_names_that_never_collide() -> None:
+    rng = np.random.default_rng(1)
+    els = []
+    for i in range(1000):
+        ang = np.sort(rng.uniform(0, 2 * np.pi, 5))
+        pts = rng.uniform(3, 8, 5) * np.exp(1j * ang) + complex(30 * (i % 40), 30 * (i // 40))
+        q = np.roll(pts, -1)
+        els.append(
+            element(np.stack([pts, pts + (q - pts) / 3, pts + 2 * (q - pts) / 3, q], axis=1), "fill:#000")
+        )
+    text = format_grammar(infer(Scene(tuple(els))).grammar)
+    g = parse_grammar(text)
+    assert len(derive(g)) == 1000
+    assert not {t.name for t in g.terminals} & {r.name for r in g.rules}
