@@ -187,27 +187,20 @@ def legend(grammar: Any, mode: str) -> list[tuple[str, str]]:
 
 
 def recolor(drawing: Any, mode: str) -> Any:
-    """Return ``drawing`` with terminal styles coloured by similarity group or by rule.
+    """Return ``drawing`` with its instances' styles coloured by similarity group or by rule.
 
     ``mode`` is ``"none"`` (unchanged), ``"group"`` (one colour per terminal symbol, i.e. per
-    similarity group) or ``"rule"`` (one colour per rule that emitted the instance; terminals
-    drawn by several rules are split into one styled copy per rule).
+    similarity group) or ``"rule"`` (one colour per rule that emitted the instance).  Each
+    instance keeps its own style (opacity, stroke width, …) with fill and stroke recoloured.
     """
     if mode == "none" or drawing is None or len(drawing) == 0:
         return drawing
-    terms = drawing.terminals
-    if mode == "group":
-        styled = tuple(
-            dataclasses.replace(t, style=_style_with_color(t.style, group_color(i)))
-            for i, t in enumerate(terms)
-        )
-        return dataclasses.replace(drawing, terminals=styled)
-    pairs, inverse = np.unique(np.stack([drawing.symbol, drawing.rule], axis=1), axis=0, return_inverse=True)
-    styled = tuple(
-        dataclasses.replace(terms[s], style=_style_with_color(terms[s].style, rule_color(r)))
-        for s, r in pairs.tolist()
-    )
-    return dataclasses.replace(drawing, terminals=styled, symbol=inverse.reshape(-1).astype(np.int32))
+    styles, style = drawing.instance_styles()
+    key = np.asarray(drawing.symbol if mode == "group" else drawing.rule, np.int64)
+    color = group_color if mode == "group" else rule_color
+    pairs, inverse = np.unique(np.stack([style, key], axis=1), axis=0, return_inverse=True)
+    styled = tuple(_style_with_color(styles[s], color(k)) for s, k in pairs.tolist())
+    return dataclasses.replace(drawing, styles=styled, style=inverse.reshape(-1).astype(np.int32))
 
 
 class Canvas(QWidget):

@@ -150,4 +150,3 @@ def rename_symbols(g: Grammar, names: dict[str, str]) -> Grammar:
         for r in g.rules
     )
     return replace(g, terminals=terminals, rules=rules, axiom=body(g.axiom))
-

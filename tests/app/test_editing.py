@@ -271,11 +271,12 @@ def test_color_modes_and_overlay(window, helix_lsys, wait_idle):
     wait_idle(window)
     drawing = window.doc.drawing
     by_rule = recolor(drawing, "rule")
-    assert len(by_rule.terminals) == 2  # terminal A drawn by the axiom and by rule P: two colours
-    assert len({t.style for t in by_rule.terminals}) == 2
-    assert np.array_equal(by_rule.symbol, (drawing.rule == 0).astype(int))
-    by_group = recolor(drawing, "group")
-    assert "stroke:#1f77b4" in by_group.terminals[0].style and "fill:none" in by_group.terminals[0].style
+    styles, style = by_rule.instance_styles()
+    assert len(styles) == 2  # terminal A drawn by the axiom and by rule P: two colours
+    assert len(set(styles)) == 2 and np.array_equal(style == style[drawing.rule == 0][0], drawing.rule == 0)
+    assert by_rule.terminals == drawing.terminals  # the shapes stay, only the instances' paint changes
+    styles, style = recolor(drawing, "group").instance_styles()
+    assert len(styles) == 1 and "stroke:#1f77b4" in styles[0] and "fill:none" in styles[0]
     window.act_colors["rule"].trigger()
     wait_idle(window)
     frame = window.canvas._frame

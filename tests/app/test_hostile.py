@@ -210,7 +210,7 @@ def test_odd_but_readable_svg_is_inferred_and_drawn(
     frame = window.canvas._frame
     assert frame is not None and frame.drawing is doc.drawing and not frame.draft
     assert frame.image.width() > 0 and frame.pixels[..., :3].min() < 255  # something is drawn
-    assert doc.text.startswith("lsys 1") and doc.error is None
+    assert doc.text.startswith("lsys 2") and doc.error is None
     note = SVG_OK[name]
     if note is None:
         assert not window.message_bar.text()
