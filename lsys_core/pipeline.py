@@ -294,7 +294,7 @@ def paint_like_input(grammar: Grammar, scene: Scene, inst: Instancing) -> Gramma
         [t.name for t in drawing.terminals], drawing.symbol, drawing.a, drawing.b, names, inst.a, inst.b
     )
     if match is not None:
-        grammar = fit_paint(grammar, [e.style for e in scene.elements], orders, match, trace)
+        grammar = fit_paint(grammar, [e.style for e in scene.elements], orders, match, trace, drawing)
     verbatim = tuple(
         replace(v, order=int(np.count_nonzero(orders < v.order)))
         for v in sorted(scene.verbatim, key=lambda v: v.order)

@@ -4,6 +4,9 @@ The hierarchy writes rules for the geometry only.  Here the grammar is derived o
 derived instance is matched to the input element it reproduces, and the grammar is given
 what the elements' paint needs:
 
+- **strokes** — a terminal whose instances' stroke widths (and dashes) are proportional to
+  their scale, as when each copy was drawn with a scaling ``transform``, is marked
+  ``scaled``: one style in its own units serves every instance;
 - **styles** — every terminal occurrence whose instances share one style gets it
   (``A{s2}``, nothing when it is the terminal's own base style); when the instances differ
   only in numbers linear in the rule's counter (opacity fading, stroke width growing), the
@@ -17,11 +20,13 @@ what the elements' paint needs:
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 
 import numpy as np
 
 from lsys_core.derive.derivation import Trace
+from lsys_core.derive.model import Drawing
 from lsys_core.derive.paint import css_decls, css_text
 from lsys_core.grammar.model import Grammar, Linear, Module, NamedStyle, Paint, Symbol
 
@@ -31,6 +36,11 @@ __all__ = ["fit_paint", "match_instances"]
 _NUMERIC = ("opacity", "fill-opacity", "stroke-opacity", "stroke-width")
 #: Largest exact assignment problem solved per terminal; larger groups match greedily.
 _ASSIGN_LIMIT = 1500
+#: Style lengths that a ``scaled`` terminal's instances scale with their turtle.
+_LENGTHS = ("stroke-width", "stroke-dasharray", "stroke-dashoffset")
+#: Relative agreement of stroke widths over scales for a terminal to count as ``scaled``
+#: (styles carry six digits; poses are fitted).
+_SCALED_TOL = 2e-3
 
 
 def match_instances(
@@ -94,7 +104,12 @@ def _greedy(target: np.ndarray, found: np.ndarray, ids: np.ndarray) -> np.ndarra
 
 
 def fit_paint(
-    g: Grammar, element_styles: list[str], element_order: np.ndarray, match: np.ndarray, trace: Trace
+    g: Grammar,
+    element_styles: list[str],
+    element_order: np.ndarray,
+    match: np.ndarray,
+    trace: Trace,
+    drawing: Drawing,
 ) -> Grammar:
     """Return ``g`` with styles and paint order that reproduce the matched elements'.
 
@@ -110,8 +125,11 @@ def fit_paint(
         Element index of every derived instance (in the trace's order).
     trace : Trace
         The derivation's trace.
+    drawing : Drawing
+        The derivation's drawing (same order as the trace).
     """
     styles = np.asarray(element_styles, dtype=object)[match]
+    g, styles = _scaled_strokes(g, styles, drawing)
     order = np.asarray(element_order, float)[match]
     edits: dict[tuple[str, int, int], dict] = {}
     g, table = _fit_styles(g, styles, trace, edits)
@@ -122,6 +140,56 @@ def fit_paint(
     if z_table is not None:
         g = replace(g, order=z_table)
     return g
+
+
+def _scaled_strokes(g: Grammar, styles: np.ndarray, drawing: Drawing) -> tuple[Grammar, np.ndarray]:
+    """Mark ``scaled`` the terminals whose instances' stroke lengths are proportional to their scale.
+
+    Their instances' styles are rewritten in the terminal's own units (the lengths divided by
+    the instance's scale), so that copies drawn with one style through scaling transforms
+    share one style again.
+    """
+    scale = np.abs(np.asarray(drawing.a, complex))
+    styles = styles.copy()
+    scaled = set()
+    for t, term in enumerate(drawing.terminals):
+        mine = np.flatnonzero(drawing.symbol == t)
+        if mine.size < 2 or term.scaled or np.ptp(scale[mine]) <= _SCALED_TOL * scale[mine].max():
+            continue
+        local = _local_lengths([str(v) for v in styles[mine]], scale[mine])
+        if local is not None:
+            styles[mine] = local
+            scaled.add(term.name)
+    if not scaled:
+        return g, styles
+    terms = tuple(replace(t, scaled=True) if t.name in scaled else t for t in g.terminals)
+    return replace(g, terminals=terms), styles
+
+
+def _local_lengths(styles: list[str], scale: np.ndarray) -> list[str] | None:
+    """Return the styles with their lengths divided by ``scale``, if that makes them one style."""
+    decls = [css_decls(s) for s in styles]
+    if any(d.keys() != decls[0].keys() for d in decls) or "stroke-width" not in decls[0]:
+        return None
+    rest = [{k: v for k, v in d.items() if k not in _LENGTHS} for d in decls]
+    if any(r != rest[0] for r in rest):
+        return None
+    out = dict(decls[0])
+    for key in _LENGTHS:
+        if key not in out:
+            continue
+        try:
+            values = np.array([[float(x) for x in re.split(r"[\s,]+", d[key].strip())] for d in decls])
+        except ValueError:
+            return None  # units, keywords or lists of different lengths
+        local = values / scale[:, None]
+        mid = np.median(local, axis=0)
+        if np.any(np.abs(local - mid) > _SCALED_TOL * np.maximum(np.abs(mid), 1e-12)):
+            return None
+        out[key] = " ".join(f"{v:.6g}" for v in mid)
+    if all(d == decls[0] for d in decls):
+        return None  # one style already: canvas units serve
+    return [css_text(out)] * len(styles)
 
 
 def _named(names: dict[str, str], css: str) -> str:
@@ -200,13 +268,25 @@ def _linear_props(styles: list[str], m: np.ndarray) -> tuple[str, list[tuple[str
             return None
         cd, c0 = np.polyfit(mm, v, 1)
         fit = c0 + cd * mm
-        if np.abs(fit - v).max() > 1e-6 * max(1.0, float(np.abs(v).max())) + 5e-7:
+        if np.abs(fit - v).max() > _written_precision([d[k] for d in decls], v):
             return None
         props.append((k, Linear(_round(c0), _round(cd))))
     common = dict(decls[0])
     for k in varying:
         common.pop(k)
     return css_text(common), props
+
+
+def _written_precision(texts: list[str], values: np.ndarray) -> float:
+    """How far numbers written as ``texts`` may be from the values they round.
+
+    Half a unit of the last decimal the most precise of them writes (``.14``, ``.29``, ``.43``:
+    0.005, so sevenths written with two decimals are one progression), and at least six
+    significant digits' worth.
+    """
+    decimals = [len(t.split(".", 1)[1]) for t in texts if "." in t and t.replace(".", "", 1).isdigit()]
+    written = 0.5 * 10.0 ** -max(decimals) if decimals else 0.0
+    return max(written * (1 + 1e-9), 1e-6 * max(1.0, float(np.abs(values).max())) + 5e-7)
 
 
 def _round(x: float) -> float:

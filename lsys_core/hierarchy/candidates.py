@@ -58,8 +58,10 @@ class Candidate:
         The live nodes of every application, its first node first.
     h, phi, l : float
         Proximity, similarity and (relative) sequence length of the importance.
-    start : float
-        Mean input order of the applications' first elements (ties go to the drawing order).
+    start : tuple of float
+        Mean input order of the applications' first elements, then of their second ones (ties
+        go to the drawing order: of a ring read either way from one element, the way the art
+        was drawn).
     slack : tuple of float
         Per application, how much farther its elements may still move within the tolerance
         once the rule places them (set when the candidate is accepted).
@@ -75,7 +77,7 @@ class Candidate:
     h: float
     phi: float
     l: float
-    start: float = 0.0
+    start: tuple[float, float] = (0.0, 0.0)
     slack: tuple[float, ...] = ()
     starts: tuple[tuple[complex, complex], ...] = ()
     gain: float = 0.0

@@ -222,7 +222,7 @@ def build_hierarchy(
         chosen: list[Candidate] = []
         if cands and level < MAX_LEVELS:
             first = nodes.first_members()
-            cands = [replace(c, start=float(np.mean([first[g[0]] for g in c.groups]))) for c in cands]
+            cands = [replace(c, start=_start(c, first)) for c in cands]
             test = partial(
                 _worthwhile,
                 ledger=ledger,
@@ -365,6 +365,12 @@ def _admitted(
     return replace(c, slack=tuple(float(v) for v in slack), starts=poses, gain=gain)
 
 
+def _start(c: Candidate, first: np.ndarray) -> tuple[float, float]:
+    """Mean input order of the first and of the second elements of a candidate's applications."""
+    second = [first[g[1]] if g.size > 1 else first[g[0]] for g in c.groups]
+    return float(np.mean([first[g[0]] for g in c.groups])), float(np.mean(second))
+
+
 def _scores(cands: list[Candidate], w: Weights) -> np.ndarray:
     """The importance ``w = wn·n + wh·h + wφ·φ + wl·l`` of every candidate (§5.4, eq. 5)."""
     cov = max(c.covered for c in cands)
@@ -391,7 +397,9 @@ def _choose(
     """
     scores = np.round(_scores(cands, weights), 9)
     order = sorted(
-        range(len(cands)), key=lambda i: (scores[i], cands[i].covered, -cands[i].start), reverse=True
+        range(len(cands)),
+        key=lambda i: (scores[i], cands[i].covered, -cands[i].start[0], -cands[i].start[1]),
+        reverse=True,
     )
     taken = np.zeros(n_nodes, bool)
     out: list[Candidate] = []
@@ -404,7 +412,7 @@ def _choose(
         for i in tied:
             if not taken[cands[i].nodes()].any() and (c := worthwhile(cands[i])) is not None:
                 found.append(c)
-        for c in sorted(found, key=lambda c: (c.gain, c.covered, -c.start), reverse=True):
+        for c in sorted(found, key=lambda c: (c.gain, c.covered, -c.start[0], -c.start[1]), reverse=True):
             nodes = c.nodes()
             if taken[nodes].any():
                 continue

@@ -119,6 +119,31 @@ def test_stroke_width_stays_as_drawn_on_a_shape_reused_at_three_scales() -> None
     assert_same_picture(scene, out, (0, 20, 120, 60))
 
 
+def test_strokes_scaled_with_their_copies_need_one_style() -> None:
+    # one shape drawn through scaling transforms: each copy's stroke is as much wider as it is larger
+    svg = (
+        '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 160 60">'
+        + "".join(
+            f'<path transform="translate({x} 30) scale({k})" d="M-4 -4 L4 -4 L0 5 Z" '
+            'style="fill:none;stroke:#000;stroke-width:1"/>'
+            for x, k in ((15, 1), (45, 2), (100, 4.5))
+        )
+        + "</svg>"
+    )
+    scene = parse_svg(svg)
+    text = format_grammar(infer(scene).grammar)
+    g = parse_grammar(text)
+    assert len(g.terminals) == 1 and g.terminals[0].scaled
+    assert not g.styles and not g.paint and "stroke-width:1" in g.terminals[0].style
+    out = derive(g)
+    back = parse_svg(drawing_to_svg(out))
+    widths = sorted(
+        float(dict(p.split(":") for p in e.style.split(";"))["stroke-width"]) for e in back.elements
+    )
+    assert widths == pytest.approx([1, 2, 4.5], rel=1e-3)
+    assert_same_picture(scene, out, (0, 0, 160, 60))
+
+
 def test_shapes_differing_only_in_style_are_one_terminal() -> None:
     styles = ["fill:#e41a1c", "fill:#377eb8;stroke:#000;stroke-width:1.5", "fill:#4daf4a;opacity:0.5"]
     els = [element(square(complex(15 + 20 * i, 30), 12), styles[(i * 7) % 3]) for i in range(9)]
@@ -132,17 +157,23 @@ def test_shapes_differing_only_in_style_are_one_terminal() -> None:
     assert_same_picture(scene, out, (0, 0, 200, 60))
 
 
-def test_an_opacity_progression_is_one_rule_with_a_parameter() -> None:
-    # a spinner: twelve bars around a centre, each a little more transparent
+@pytest.mark.parametrize(
+    ("count", "opacity"),
+    [
+        (12, lambda k: f"{1 - k / 12:.6g}"),  # twelve bars round a centre, each more transparent
+        (7, lambda k: f"{(k + 1) / 7:.2f}"),  # seven bars in sevenths written .14 .29 … .86 1.00
+    ],
+)
+def test_an_opacity_progression_is_one_rule_with_a_parameter(count, opacity) -> None:
     bars = []
-    for k in range(12):
+    for k in range(count):
         turn = k * np.pi / 6
         centre = 50 + 50j + 30 * np.exp(1j * turn)
         bar = np.array([-8 - 2j, 8 - 2j, 8 + 2j, -8 + 2j, -8 - 2j])
         pts = centre + bar * np.exp(1j * turn)
         p, q = pts[:-1], pts[1:]
         cubics = np.stack([p, p + (q - p) / 3, p + 2 * (q - p) / 3, q], axis=1)
-        bars.append(element(cubics, f"fill:#333;opacity:{1 - k / 12:.6g}"))
+        bars.append(element(cubics, f"fill:#333;opacity:{opacity(k)}"))
     scene = Scene(tuple(bars))
     out, text = round_trip(scene)
     g = parse_grammar(text)
