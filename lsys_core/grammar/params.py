@@ -1,6 +1,7 @@
 """Name, list and change the numeric parameters of a grammar (editor sliders, ``--set NAME=VALUE``).
 
-Every turtle value ``t(m) = t0 + tΔ·m`` contributes its ``t0`` (and its ``tΔ`` when non-zero),
+Every turtle value ``t(m) = t0 + tΔ·m`` but the paint-order moves ``z`` contributes its ``t0``
+(and its ``tΔ`` when non-zero),
 and every constant counter argument (``P(119)`` in the axiom, ``Q(5)`` in a body) is a
 ``count``.  A parameter's key is ``{owner}.{case}.{index}.{field}``:
 
@@ -85,6 +86,8 @@ def list_params(g: Grammar) -> list[Param]:
         nth: Counter[str] = Counter()
         for i, mod in enumerate(body):
             key = f"{owner}.{ci}.{i}"
+            if isinstance(mod, Turtle) and mod.op == "z":
+                continue  # paint order, not geometry: not a slider (set_param still takes its key)
             if isinstance(mod, Turtle):
                 nth[mod.op] += 1
                 label = f"{prefix}: {mod.op} #{nth[mod.op]}"

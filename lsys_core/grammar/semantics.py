@@ -118,6 +118,8 @@ def _runs(owner: str, ci: int, body: tuple[Module, ...]) -> Iterator[tuple[int, 
     """Yield ``(index after the run, ops)`` for every run of consecutive turtle commands."""
     run: list[_Op] = []
     for i, mod in enumerate(body):
+        if isinstance(mod, Turtle) and mod.op == "z":
+            continue  # paint order moves no geometry: the run goes on
         if isinstance(mod, Turtle):
             run.append(_Op(f"{owner}.{ci}.{i}.v", mod.op, float(mod.value.c0), float(mod.value.cd)))
             continue

@@ -275,3 +275,22 @@ def test_more_distinct_shapes_than_letters_infer_to_rules_that_derive() -> None:
     assert len(g.terminals) > 26 and g.terminal("Z") is not None
     assert len(derive(g)) == 30
     assert not {t.name for t in g.terminals} & {r.name for r in g.rules}
+
+
+def test_paint_order_moves_are_not_geometry_for_sliders_and_rule_cards() -> None:
+    from lsys_core.grammar import list_params
+    from lsys_core.grammar.semantics import describe
+
+    text = (
+        'lsys 2\nterminal A "M0 0 L1 0"\naxiom: P(5)\n'
+        "P(m): m > 0 -> A{opacity: 0.1*m} z(1) +(30) f(10) z(m) P(m-1)\nP(m): m == 0 -> A\n"
+    )
+    g = parse_grammar(text)
+    assert [(p.key, p.kind) for p in list_params(g)] == [
+        ("axiom.0.0.m", "count"),
+        ("P.0.2.v", "angle"),
+        ("P.0.3.v", "distance"),
+    ]
+    card = next(c for c in describe(g) if c.owner == "P")
+    assert card.kind == "arc" and card.count == 6
+    assert {w.key for c in card.controls for w in c.writes} == {"axiom.0.0.m", "P.0.2.v", "P.0.3.v"}
