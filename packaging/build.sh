@@ -58,7 +58,7 @@ run() { (cd "$SMOKE" && env -u PYTHONPATH -u PYTHONHOME -u VIRTUAL_ENV "$@"); }
 run "$BUNDLE/lsys" --version
 run "$BUNDLE/lsys" -q infer "$EXAMPLES/helix.svg" -o "$SMOKE/helix.lsys" --png "$SMOKE/helix.png"
 run "$BUNDLE/lsys" derive "$SMOKE/helix.lsys" -o "$SMOKE/helix.svg" --set m=60
-grep -q '<path' "$SMOKE/helix.svg"
+grep -q '<use' "$SMOKE/helix.svg"
 QT_QPA_PLATFORM=offscreen run "$BUNDLE/lsys-editor" "$ROOT/resources/examples/helix.svg" \
     --screenshot "$ROOT/build/smoke.png"
 head -c 8 "$ROOT/build/smoke.png" | od -An -tx1 | tr -d ' \n' | grep -q '^89504e470d0a1a0a$' \

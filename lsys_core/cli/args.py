@@ -51,6 +51,15 @@ def _weights(p: argparse.ArgumentParser) -> None:
     )
 
 
+def _flat(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--flat",
+        action="store_true",
+        help="write SVG as one baked <path> per instance (default: shapes once in <defs>, "
+        "instances as <use>, a <g> per rule call), for tools that do not understand <use>",
+    )
+
+
 def _png(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("PNG output")
     g.add_argument("--png", metavar="OUT.png", help="write the drawing as PNG ('-': standard output)")
@@ -87,6 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
     inf.add_argument(
         "--report", help="write a JSON report (elements, symbols, rules, axiom, seconds, stages)"
     )
+    _flat(inf)
     _png(inf)
     _weights(inf)
 
@@ -96,6 +106,7 @@ def build_parser() -> argparse.ArgumentParser:
     sym.add_argument("input", help="input SVG ('-': standard input)")
     sym.add_argument("-o", "--output", required=True, help="output SVG ('-': standard output)")
     sym.add_argument("--rules", help="also write the rules (.lsys)")
+    _flat(sym)
     _weights(sym)
 
     der = sub.add_parser("derive", parents=[common], help="derive rules into SVG/PNG")
@@ -115,6 +126,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     der.add_argument("--seed", type=int, default=0, help="random seed for --randomize (default 0)")
     der.add_argument("--limit", type=int, default=None, help="maximum number of elements (default 1,000,000)")
+    _flat(der)
     _png(der)
 
     par = sub.add_parser("params", parents=[common], help="list the numeric parameters of a rules file")

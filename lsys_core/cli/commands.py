@@ -86,11 +86,13 @@ def _commit(files: Files) -> None:
 
 
 def _read_svg(path: str):
+    """Return the scene of an input SVG and its head (title, description, root attributes)."""
+    from lsys_core.svg.head import read_head
     from lsys_core.svg.parse import DEFAULT_MAX_BYTES, parse_svg
 
     name = _name(path)
     data = read_bytes(_source(path), limit=DEFAULT_MAX_BYTES, name=name)
-    return parse_svg(data, max_bytes=DEFAULT_MAX_BYTES, name=name)
+    return parse_svg(data, max_bytes=DEFAULT_MAX_BYTES, name=name), read_head(data)
 
 
 def _load_rules(path: str):
@@ -189,8 +191,14 @@ def _derive(grammar, **options):
         return derive(grammar, **options)
 
 
-def _drawing_outputs(drawing, svg: str | None, png: str | None, png_options: dict) -> Files:
-    """Return the SVG and PNG files of a drawing as ``(target, content)``, computed in memory."""
+def _drawing_outputs(
+    drawing, svg: str | None, png: str | None, png_options: dict, *, flat: bool = False, head=None
+) -> Files:
+    """Return the SVG and PNG files of a drawing as ``(target, content)``, computed in memory.
+
+    The SVG is structured (shapes in ``<defs>``, ``<use>`` instances, a group per rule call),
+    or with ``flat`` one baked ``<path>`` per instance.
+    """
     import numpy as np
 
     out: Files = []
@@ -201,7 +209,12 @@ def _drawing_outputs(drawing, svg: str | None, png: str | None, png_options: dic
     check_finite(drawing)  # an overflowing grammar is an error, not an empty or broken picture
     with np.errstate(all="ignore"):
         if svg:
-            out.append((svg, drawing_to_svg(drawing)))
+            if flat:
+                out.append((svg, drawing_to_svg(drawing)))
+            else:
+                from lsys_core.render.structured import drawing_to_structured_svg
+
+                out.append((svg, drawing_to_structured_svg(drawing, head=head)))
         if png:
             from lsys_core.render.raster import encode_png
 
@@ -275,7 +288,7 @@ def _cmd_infer(args, progress: Progress, say: Say, symmetrize: bool = False) -> 
     settings = _settings(args)
     png_options = _png_options(args)
     t0 = time.perf_counter()
-    scene = _read_svg(args.input)
+    scene, head = _read_svg(args.input)
     t_import = time.perf_counter() - t0
     if not args.quiet:
         for w in scene.warnings:
@@ -290,13 +303,13 @@ def _cmd_infer(args, progress: Progress, say: Say, symmetrize: bool = False) -> 
     text = format_grammar(result.grammar)
     files: Files = []
     if symmetrize:
-        files += _drawing_outputs(drawing, args.output, None, {})
+        files += _drawing_outputs(drawing, args.output, None, {}, flat=args.flat, head=head)
         if args.rules:
             files.append((args.rules, text))
     else:
         if args.output:
             files.append((args.output, text))
-        files += _drawing_outputs(drawing, args.svg, png, png_options)
+        files += _drawing_outputs(drawing, args.svg, png, png_options, flat=args.flat, head=head)
         if args.report:
             rep = _infer_report(result, scene, drawing)
             rep["seconds"] = round(time.perf_counter() - t0, 4)
@@ -337,7 +350,7 @@ def _cmd_derive(args, say: Say) -> int:
     t = time.perf_counter()
     drawing = _derive(g, limit=limit, randomize=rnd)
     seconds = time.perf_counter() - t
-    _commit(_drawing_outputs(drawing, args.output, args.png, png_options))
+    _commit(_drawing_outputs(drawing, args.output, args.png, png_options, flat=args.flat))
     if args.verbose:
         say(f"lsys: derived {len(drawing):,} elements in {seconds * 1000:.1f} ms")
     return 0

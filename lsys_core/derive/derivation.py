@@ -27,7 +27,7 @@ import numpy as np
 from lsys_core.cancel import CancelToken, check
 from lsys_core.derive.compile import Compiled, Program, compile_grammar
 from lsys_core.derive.jitter import jitter_instances
-from lsys_core.derive.model import Drawing
+from lsys_core.derive.model import Calls, Drawing
 from lsys_core.derive.order import Items, string_positions
 from lsys_core.derive.paint import paint_z, resolve_styles
 from lsys_core.errors import LimitError
@@ -257,12 +257,13 @@ class _Derivation:
         self.emitter = _Emitter(limit)
         self.interp = _Interpreter(randomize)
         self.items = Items()
+        self.call_info: list[tuple[int, np.ndarray, bool]] = []  # (rule, counters, continues) per chunk
         self.work_budget = 4 * max(limit, 1000)
         self.work = 0
         self.pending: dict[int, list] = {}
         self.queue: deque[int] = deque()
 
-    def push(self, target: int, m, a, b, z, parent, rank) -> None:
+    def push(self, target: int, m, a, b, z, parent, rank, continues: bool = False) -> None:
         """Queue calls of rule ``target`` (dropping parametric ones with a negative counter)."""
         m = np.asarray(m, np.int64)
         if m.size == 0:
@@ -277,6 +278,7 @@ class _Derivation:
                 if m.size == 0:
                     return
         ids = self.items.add(parent, rank)
+        self.call_info.append((target, m, continues))  # item ids are consecutive: entry i - 1 is item i's
         if target not in self.pending:
             self.pending[target] = []
             self.queue.append(target)
@@ -386,7 +388,22 @@ class _Derivation:
             end_z[has] = step_z[li] + z_net[li]
         m_end = m - lengths * c
         keep = has & (m_end >= 0)
-        self.push(r, m_end[keep], end_a[keep], end_b[keep], end_z[keep], ids[keep], lengths[keep] * stride)
+        self.push(
+            r, m_end[keep], end_a[keep], end_b[keep], end_z[keep], ids[keep], lengths[keep] * stride, True
+        )
+
+    def calls(self, call: np.ndarray) -> Calls:
+        """Return the call tree (the derivation's items) and the call of every instance."""
+        parent = np.full(self.items.count, -1, np.int64)
+        for first, par, _ in self.items.chunks:
+            parent[first : first + par.size] = par
+        info = self.call_info
+        rule_of = np.concatenate([[-1], *(np.full(ms.size, r) for r, ms, _ in info)]).astype(np.int64)
+        m = np.concatenate([[0], *(ms for _, ms, _ in info)]).astype(np.int64)
+        continues = np.concatenate([[False], *(np.full(ms.size, c) for _, ms, c in info)]).astype(bool)
+        names = ("", *(r.name for r in self.grammar.rules))
+        rules = tuple(names[r + 1] for r in rule_of.tolist())
+        return Calls(np.asarray(call, np.int64), parent, rules, m, continues)
 
     def collect(self) -> tuple[Drawing, Trace]:
         """Sort the instances into paint order and build the drawing and its trace."""
@@ -409,6 +426,7 @@ class _Derivation:
             x[order] for x in (sym, a, b, z, rule, m, slot, paint, pos)
         )
         styles, style = resolve_styles(g, self.program.paints, sym, paint, m, pos)
+        calls = self.calls(parent[order])
         drawing = Drawing(
             g.terminals,
             sym,
@@ -421,5 +439,6 @@ class _Derivation:
             style=style,
             defs=g.defs,
             verbatim=g.verbatim,
+            calls=calls,
         )
         return drawing, Trace(pos, slot, m, z, tuple(self.program.slots))

@@ -9,7 +9,38 @@ import numpy as np
 from lsys_core.geometry.transforms import frames_to_matrices
 from lsys_core.grammar.model import Terminal, Verbatim
 
-__all__ = ["Drawing"]
+__all__ = ["Calls", "Drawing"]
+
+
+@dataclass(frozen=True, eq=False)
+class Calls:
+    """How a drawing's instances come from rule calls: the derivation's call tree.
+
+    A call is one use of a non-terminal in a body (``P1(7)`` in the axiom) and what its
+    rewriting draws.  A rule that calls itself at the end of its body with a smaller counter
+    (``P1(m): m > 0 -> A f(1) P1(m-1)``) repeats: its repetitions, and the call that ends the
+    sequence (``P1(0)``), *continue* the call that started it (``continues``), so a sequence is
+    one call and its groups do not nest a level per step.  Call 0 is the axiom.
+
+    Attributes
+    ----------
+    call : ndarray of int64, shape (n,)
+        The call whose body drew each instance (in the drawing's order).
+    parent : ndarray of int64, shape (k,)
+        The call each call was made from (-1 for the axiom).
+    rule : tuple of str
+        The rule name of every call ("" for the axiom).
+    m : ndarray of int64, shape (k,)
+        The counter each call was made with (0 for the axiom and plain rules).
+    continues : ndarray of bool, shape (k,)
+        Whether a call continues its parent's sequence (see above).
+    """
+
+    call: np.ndarray
+    parent: np.ndarray
+    rule: tuple[str, ...]
+    m: np.ndarray
+    continues: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -36,6 +67,8 @@ class Drawing:
         SVG markup the styles refer to by ``url(#id)``.
     verbatim : tuple of Verbatim
         Content drawn as is; ``order`` is the number of instances drawn before it.
+    calls : Calls or None
+        The rule calls the instances come from (None: not known, e.g. a drawing built by hand).
 
     Stroke widths and dashes in the styles are in canvas units, except for terminals whose
     ``scaled`` flag is set (they scale with the instance, see :meth:`stroke_scale`).
@@ -52,6 +85,7 @@ class Drawing:
     style: np.ndarray | None = None
     defs: str = ""
     verbatim: tuple[Verbatim, ...] = ()
+    calls: Calls | None = None
 
     def __len__(self) -> int:
         return int(self.symbol.size)

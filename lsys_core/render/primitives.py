@@ -7,7 +7,8 @@ edit) the element they drew.  :func:`primitive` decides from the geometry alone:
 
 - a line: one open subpath of one straight segment;
 - a rectangle: one closed subpath of four straight sides at right angles (rotated ones get a
-  ``transform="rotate(…)"``);
+  ``transform="rotate(…)"``), or of four straight sides joined by quarter circles or quarter
+  ellipses (a rounded rectangle: ``rx``, ``ry``);
 - an ellipse or a circle: one closed subpath of curved segments whose points all lie on one
   ellipse, going round it exactly once (the conic is fitted by least squares, then every
   sample is checked against it).
@@ -95,7 +96,7 @@ def primitive(d: str) -> tuple[str, dict[str, str]] | None:
         return _rect(cubics, tol)
     if not straight.any():
         return _ellipse(cubics, tol)
-    return None
+    return _rounded_rect(cubics, straight, tol)
 
 
 def _rect(cubics: np.ndarray, tol: float) -> tuple[str, dict[str, str]] | None:
@@ -123,6 +124,53 @@ def _rect(cubics: np.ndarray, tol: float) -> tuple[str, dict[str, str]] | None:
     attrs |= {"width": _num(w), "height": _num(h)}
     if abs(angle) > 1e-7:
         attrs["transform"] = f"rotate({_num(angle)} {_num(centre.real, unit)} {_num(centre.imag, unit)})"
+    return "rect", attrs
+
+
+def _rounded_rect(cubics: np.ndarray, straight: np.ndarray, tol: float) -> tuple[str, dict[str, str]] | None:
+    """A rectangle with round (circular or elliptical) corners: straight sides joined by quarter arcs."""
+    sides = cubics[straight, 3] - cubics[straight, 0]
+    angle = math.atan2(sides[0].imag, sides[0].real)
+    rot = np.exp(-1j * angle)
+    turned = sides * rot  # every side along the x or the y axis
+    along_x = np.abs(turned.imag) <= tol
+    along_y = np.abs(turned.real) <= tol
+    if not np.all(along_x | along_y) or along_x.sum() < 2 or along_y.sum() < 2:
+        return None
+    pts = sample_cubics(cubics, 8) * rot
+    x0, x1, y0, y1 = pts.real.min(), pts.real.max(), pts.imag.min(), pts.imag.max()
+    hw, hh = (x1 - x0) / 2, (y1 - y0) / 2
+    centre = complex((x0 + x1) / 2, (y0 + y1) / 2)
+    # each of the two sides along x is as long as the width minus both corners
+    rx = hw - float(np.abs(turned[along_x]).sum()) / 4
+    ry = hh - float(np.abs(turned[along_y]).sum()) / 4
+    if not (tol < rx <= hw + tol and tol < ry <= hh + tol):
+        return None
+    q = pts - centre
+    ax, ay = np.abs(q.real), np.abs(q.imag)
+    cx, cy = np.maximum(ax - (hw - rx), 0), np.maximum(ay - (hh - ry), 0)
+    corner = (cx > 0) & (cy > 0)
+    on_side = np.minimum(np.abs(ax - hw), np.abs(ay - hh))
+    on_corner = np.abs(np.hypot(cx / rx, cy / ry) - 1.0) * min(rx, ry)
+    if np.where(corner, on_corner, on_side).max() > tol:
+        return None
+    turns = np.angle(np.exp(1j * np.diff(np.unwrap(np.angle(q)))))
+    if abs(abs(turns.sum()) - 2 * math.pi) > 1e-3:
+        return None
+    deg = math.degrees(angle)
+    quarter = round(deg / 90.0)
+    deg -= 90.0 * quarter
+    w, h, rx_, ry_ = 2 * hw, 2 * hh, rx, ry
+    if quarter % 2:
+        w, h, rx_, ry_ = h, w, ry, rx
+    centre = centre / rot
+    unit = w + h
+    attrs = {"x": _num(centre.real - w / 2, unit), "y": _num(centre.imag - h / 2, unit)}
+    attrs |= {"width": _num(w), "height": _num(h), "rx": _num(rx_)}
+    if abs(rx_ - ry_) > tol:
+        attrs["ry"] = _num(ry_)
+    if abs(deg) > 1e-7:
+        attrs["transform"] = f"rotate({_num(deg)} {_num(centre.real, unit)} {_num(centre.imag, unit)})"
     return "rect", attrs
 
 
@@ -169,13 +217,14 @@ def _ellipse(cubics: np.ndarray, tol: float) -> tuple[str, dict[str, str]] | Non
     # The segments' end points lie on the drawn curve (the cubics between them only approximate
     # it): the radii are fitted to them.
     ends = cubics[:, 0]
+    rx, ry = ru * scale, rv * scale
+    if abs(rx - ry) <= tol:
+        r = float(np.abs(ends - complex(cx, cy)).mean())
+        return "circle", {"cx": _num(cx, scale), "cy": _num(cy, scale), "r": _num(r)}
     eu, ev = (ends.real - mx) / scale - uc, (ends.imag - my) / scale - vc
     fu, fv = _radii(eu * ct + ev * st, -eu * st + ev * ct)
     if fu is not None and fv is not None:
-        ru, rv = fu, fv
-    rx, ry = ru * scale, rv * scale
-    if abs(rx - ry) <= tol:
-        return "circle", {"cx": _num(cx, scale), "cy": _num(cy, scale), "r": _num((rx + ry) / 2)}
+        rx, ry = fu * scale, fv * scale
     deg = math.degrees(theta)
     if rx < ry:  # prefer rx as the larger radius along the rotated x axis
         rx, ry, deg = ry, rx, deg + 90.0

@@ -259,6 +259,18 @@ def check_finite(drawing: Drawing) -> None:
         )
 
 
-def export_svg(drawing: Drawing, path: str | os.PathLike) -> None:
-    """Write :func:`drawing_to_svg` to ``path`` atomically (see :func:`~lsys_core.io.write_atomic`)."""
-    write_atomic(path, drawing_to_svg(drawing))
+def export_svg(drawing: Drawing, path: str | os.PathLike, *, flat: bool = False, head=None) -> None:
+    """Write a drawing as SVG to ``path`` atomically (see :func:`~lsys_core.io.write_atomic`).
+
+    The default is the structured document of
+    :func:`~lsys_core.render.structured.drawing_to_structured_svg` (shapes once in ``<defs>``,
+    instances as ``<use>``, a ``<g>`` per rule call; ``head`` keeps the input's title,
+    description and root attributes); ``flat`` writes :func:`drawing_to_svg` instead, one
+    baked ``<path>`` per instance, for tools that do not understand ``<use>``.
+    """
+    if flat:
+        write_atomic(path, drawing_to_svg(drawing))
+        return
+    from lsys_core.render.structured import drawing_to_structured_svg
+
+    write_atomic(path, drawing_to_structured_svg(drawing, head=head))

@@ -36,7 +36,7 @@ def test_infer_writes_rules_svg_and_report(tmp_path) -> None:
         assert key in report["stages"]
     derived = tmp_path / "d.svg"
     assert run("derive", str(rules), "-o", str(derived)).returncode == 0
-    assert derived.read_text().count("<path") == 5
+    assert derived.read_text().count("<use") == 5
 
 
 def test_derive_set_and_randomize(tmp_path) -> None:
@@ -55,7 +55,7 @@ def test_derive_set_and_randomize(tmp_path) -> None:
         "4",
     )
     assert p.returncode == 0, p.stderr
-    assert out.read_text().count("<path") == 10
+    assert out.read_text().count("<use") == 10
     params = run("params", str(rules)).stdout
     assert "axiom.0.3.m" in params
 

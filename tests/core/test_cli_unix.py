@@ -70,7 +70,7 @@ def test_derive_and_params_read_rules_from_stdin() -> None:
     rules = RULES.read_bytes()
     p = run("derive", "-", "-o", "-", stdin=rules)
     assert p.returncode == 0, p.stderr
-    assert p.stdout.count(b"<path") == 120
+    assert p.stdout.count(b"<use") == 120
     assert b"axiom.0.3.m" in run("params", "-", stdin=rules).stdout
 
 
@@ -137,7 +137,7 @@ def test_output_writes_through_a_fifo(tmp_path) -> None:
     reader.join(300)
     assert p.returncode == 0, p.stderr
     assert stat.S_ISFIFO(os.lstat(fifo).st_mode), "the FIFO was replaced by a regular file"
-    assert got and got[0].count(b"<path") == 120
+    assert got and got[0].count(b"<use") == 120
 
 
 def test_devices_are_written_through_not_replaced() -> None:
@@ -158,8 +158,8 @@ def test_output_symlink_writes_through_to_its_target(tmp_path) -> None:
     assert run("derive", RULES, "-o", link).returncode == 0
     assert run("derive", RULES, "-o", dangling).returncode == 0
     assert link.is_symlink() and dangling.is_symlink()
-    assert target.read_text().count("<path") == 120
-    assert (tmp_path / "real" / "new.svg").read_text().count("<path") == 120
+    assert target.read_text().count("<use") == 120
+    assert (tmp_path / "real" / "new.svg").read_text().count("<use") == 120
     assert [p.name for p in tmp_path.rglob("*.tmp")] == []
 
 
@@ -188,7 +188,7 @@ def test_a_250_byte_output_name_works(tmp_path) -> None:
     name = "x" * 246 + ".svg"
     p = run("derive", RULES, "-o", name, cwd=tmp_path)
     assert p.returncode == 0, p.stderr
-    assert (tmp_path / name).read_text().count("<path") == 120
+    assert (tmp_path / name).read_text().count("<use") == 120
 
 
 # ---------------------------------------------------------------------------

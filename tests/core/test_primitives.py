@@ -35,10 +35,16 @@ def distance_to(tag: str, attrs: dict[str, str], pts: np.ndarray) -> np.ndarray:
         pivot = complex(float(parts[1]), float(parts[2]))
         c = (c - pivot) * np.exp(1j * angle) + pivot
     z = (pts - c) * np.exp(-1j * angle)
-    dx, dy = np.abs(z.real) - f["width"] / 2, np.abs(z.imag) - f["height"] / 2
-    return np.where(
-        (dx <= 0) & (dy <= 0), -np.maximum(dx, dy), np.hypot(np.maximum(dx, 0), np.maximum(dy, 0))
-    )
+    rx = f.get("rx", 0.0)
+    ry = f.get("ry", rx)
+    hw, hh = f["width"] / 2, f["height"] / 2
+    ax, ay = np.abs(z.real), np.abs(z.imag)
+    side = np.minimum(np.abs(ax - hw), np.abs(ay - hh))
+    if rx == 0:
+        return side
+    cx, cy = np.maximum(ax - (hw - rx), 0), np.maximum(ay - (hh - ry), 0)
+    corner = (cx > 0) & (cy > 0)
+    return np.where(corner, np.abs(np.hypot(cx / rx, cy / ry) - 1) * min(rx, ry), side)
 
 
 def arc_path(cx, cy, rx, ry, deg, sweeps=2) -> str:
@@ -52,12 +58,27 @@ def arc_path(cx, cy, rx, ry, deg, sweeps=2) -> str:
     return d + " Z"
 
 
+def rounded_rect(w, h, r, deg) -> str:
+    """A rectangle with round corners, centred on the origin and turned by ``deg``."""
+    rot = complex(np.exp(1j * math.radians(deg)))
+    corners = [(w / 2 - r, -h / 2), (w / 2, -h / 2 + r), (w / 2, h / 2 - r), (w / 2 - r, h / 2)]
+    corners += [(-x, -y) for x, y in corners]
+    pts = [complex(x, y) * rot for x, y in corners]
+    d = f"M{pts[-1].real!r} {pts[-1].imag!r}"
+    for k in range(0, 8, 2):
+        d += f" L{pts[k].real!r} {pts[k].imag!r} A{r} {r} 0 0 1 {pts[k + 1].real!r} {pts[k + 1].imag!r}"
+    return d + " Z"
+
+
 CASES = [
     ("M0 0 H10 V5 H0 Z", "rect"),
     ("M3 4 L13 4 L13 9 L3 9 Z", "rect"),
     ("M0 0 L10 10 L5 15 L-5 5 Z", "rect"),  # rotated 45°
     ("M0 0 L5 0 L10 0 L10 5 L0 5 Z", "rect"),  # a side in two pieces
     ("M1 2 L4 6", "line"),
+    ("M2 0 H8 A2 2 0 0 1 10 2 V3 A2 2 0 0 1 8 5 H2 A2 2 0 0 1 0 3 V2 A2 2 0 0 1 2 0 Z", "rect"),  # rx
+    ("M3 0 H7 A3 1 0 0 1 10 1 V4 A3 1 0 0 1 7 5 H3 A3 1 0 0 1 0 4 V1 A3 1 0 0 1 3 0 Z", "rect"),  # rx, ry
+    (rounded_rect(10, 5, 1.5, 30), "rect"),
     (arc_path(0, 0, 2, 2, 0), "circle"),
     (arc_path(12, 3, 1, 1, 0), "circle"),
     (arc_path(-4, 7, 5, 2, 0), "ellipse"),
@@ -87,6 +108,8 @@ def test_recognised_shapes_match_the_path(d, tag) -> None:
     [
         "M0 0 L10 0 L10 5 Z",  # triangle
         "M0 0 L10 0 L12 5 L2 5 Z",  # parallelogram
+        "M2 0 H8 A2 2 0 0 1 10 2 V3 L8 5 H2 A2 2 0 0 1 0 3 V2 A2 2 0 0 1 2 0 Z",  # a corner cut
+        "M2 0 H8 A2 2 0 0 0 10 2 V3 A2 2 0 0 1 8 5 H2 A2 2 0 0 1 0 3 V2 A2 2 0 0 1 2 0 Z",  # a corner inward
         "M0 0 L10 0 L10 5 L0 5",  # open outline
         "M2 0 A2 2 0 0 1 -2 0 Z",  # half disc
         "M0 0 C1 1 2 1 3 0 Z",  # a bump

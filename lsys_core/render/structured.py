@@ -1,0 +1,395 @@
+"""Write a :class:`~lsys_core.derive.model.Drawing` as structured SVG: shapes once, instances as ``<use>``.
+
+A designer who opens the file sees what repeats:
+
+- every terminal is written once, in ``<defs>``, with its name as ``id`` (``A``, ``leaf``);
+  a terminal that is a circle, an ellipse, a rectangle or a line is written as that element
+  (:func:`~lsys_core.render.primitives.primitive`);
+- every instance is a ``<use href="#A" transform="…">`` (a clone in Inkscape: edit the shape
+  once, every copy follows), with ``translate``/``rotate``/``scale`` written only where they
+  are not the identity;
+- every rule call is a ``<g id="P1-1" data-rule="P1" data-m="7">`` around what it drew, nested
+  as the calls nest (:class:`~lsys_core.derive.model.Calls`): the layers panel shows the
+  hierarchy and selecting a group selects one call (a row of windows, one flower).  The
+  repetitions of a sequence continue the call that started it (``Calls.continues``): one
+  group per sequence, not one level per step; groups nest at most :data:`MAX_DEPTH` deep
+  (deeper calls are written into their ancestor at that depth);
+- styles: declarations shared by all instances of a terminal go on its definition, the rest
+  on each ``<use>`` (CSS inheritance makes them apply to the shape); stroke widths and dashes
+  are in canvas units like in :func:`~lsys_core.render.svg.drawing_to_svg`;
+- paint order, ``defs``, verbatim content and instances whose style refers to ``url(#…)``
+  (written with baked coordinates) are as in the flat export, and the input document's
+  ``<title>``, ``<desc>`` and descriptive root attributes are kept when given
+  (:class:`~lsys_core.svg.head.Head`).
+
+If the paint order interleaves the instances of two calls, a call's group is written in parts
+(the later parts with ids ``P1-1.2``, ``P1-1.3``, …), so the picture stays exact.
+
+Numbers are formatted by one ``%`` operation over all instances, as in the flat export.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from xml.sax.saxutils import escape
+
+import numpy as np
+
+from lsys_core.derive.model import Calls, Drawing
+from lsys_core.derive.paint import css_decls, css_text
+from lsys_core.errors import LsysError
+from lsys_core.geometry.shapes import shape_arrays
+from lsys_core.render.primitives import primitive
+from lsys_core.render.svg import DIGITS, _attr, _baked_path, _canvas, _length, check_finite
+
+__all__ = ["drawing_to_structured_svg"]
+
+_NUM = f"%.{DIGITS}g"
+_LENGTH_KEYS = ("stroke-width", "stroke-dasharray", "stroke-dashoffset")
+#: Styles that draw a shape from its path's start point or vertices: such shapes keep their path.
+_PATH_ONLY = ("stroke-dasharray", "marker", "marker-start", "marker-mid", "marker-end")
+_ID = re.compile(r"""\bid\s*=\s*["']([^"']*)["']""")
+_XLINK = "http://www.w3.org/1999/xlink"
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+#: Deepest nesting of groups written (SVG readers, this project's included, limit nesting).
+MAX_DEPTH = 100
+#: Precision of the numbers in a terminal's path data, relative to the shape's size (a shape
+#: 1,000 px wide is written to a thousandth of a pixel).
+PATH_PRECISION = 1e-6
+
+
+def drawing_to_structured_svg(drawing: Drawing, *, head=None) -> str:
+    """Return the structured SVG document of a drawing (see the module docstring).
+
+    Parameters
+    ----------
+    drawing : Drawing
+        The derived instances, in paint order; its ``calls`` give the groups (without them
+        the instances are written without groups).
+    head : lsys_core.svg.head.Head, optional
+        Root attributes, title and description of the input document to keep.
+
+    Raises
+    ------
+    LsysError
+        When a pose is not finite.
+    """
+    check_finite(drawing)
+    n = len(drawing)
+    extra_xml = drawing.defs + "".join(v.xml for v in drawing.verbatim)
+    ids = _Ids(_ID.findall(extra_xml) + [v for k, v in (head.attributes if head else ()) if k == "id"])
+    out = [_root(drawing, head, "xlink:" in extra_xml)]
+    symbol = np.asarray(drawing.symbol, np.intp).reshape(n)
+    a = np.asarray(drawing.a, complex).reshape(n)
+    b = np.asarray(drawing.b, complex).reshape(n)
+    styles, style = drawing.instance_styles()
+    style = np.asarray(style, np.intp).reshape(n)
+    baked = np.array(["url(" in s for s in styles] + [False], bool)[style] if n else np.zeros(0, bool)
+    scale = drawing.stroke_scale() if n else np.zeros(0)
+    uses, defs = _uses(drawing, symbol, style, styles, scale, ~baked, ids)
+    defs_xml = drawing.defs.strip()
+    if defs_xml.startswith("<defs"):
+        defs_xml = defs_xml[defs_xml.index(">") + 1 : defs_xml.rindex("</defs>")].strip()
+    if defs_xml or defs:
+        out.append("<defs>\n" + (defs_xml + "\n" if defs_xml else "") + "".join(defs) + "</defs>\n")
+    head_text = "".join(out)
+    if n == 0:
+        return head_text + "".join(v.xml.strip() + "\n" for v in drawing.verbatim) + "</svg>\n"
+    values, used, formats = _values(a, b, scale, uses, drawing)
+    parts = np.asarray(formats, dtype=object)[uses.key]
+    for i in np.flatnonzero(baked).tolist():
+        parts[i] = _baked_path(drawing, int(symbol[i]), a[i], b[i], styles[style[i]])
+        used[i] = False
+    extra: dict[int, str] = {}
+    for v in drawing.verbatim:
+        k = min(max(int(v.order), 0), n)
+        extra[k] = extra.get(k, "") + v.xml.strip().replace("%", "%%") + "\n"
+    body = _grouped(parts, drawing.calls, extra, ids)
+    values += 0.0  # no "-0"
+    return head_text + body % tuple(values[used].tolist()) + "</svg>\n"
+
+
+class _Ids:
+    """Unique, readable XML ids: the wanted name, or the name with a number appended."""
+
+    def __init__(self, taken) -> None:
+        self.taken = set(taken)
+
+    def get(self, wanted: str) -> str:
+        base = re.sub(r"[^\w.-]", "_", wanted) or "shape"
+        if not (base[0].isalpha() or base[0] == "_"):
+            base = "_" + base
+        name, k = base, 1
+        while name in self.taken:
+            k += 1
+            name = f"{base}.{k}"
+        self.taken.add(name)
+        return name
+
+
+def _root(drawing: Drawing, head, xlink: bool) -> str:
+    vb, size = _canvas(drawing)
+    attrs = [("xmlns", "http://www.w3.org/2000/svg")]
+    if xlink:
+        attrs.append(("xmlns:xlink", _XLINK))
+    kept = list(head.attributes) if head else []
+    attrs += [kv for kv in kept if kv[0].startswith("xmlns:") and kv[1] != _XLINK]
+    attrs += [("width", size[0]), ("height", size[1]), ("viewBox", " ".join(f"{v:.{DIGITS}g}" for v in vb))]
+    attrs += [kv for kv in kept if not kv[0].startswith("xmlns")]
+    text = (
+        '<?xml version="1.0" encoding="UTF-8"?>\n<svg '
+        + " ".join(f'{k}="{_attr(v)}"' for k, v in attrs)
+        + ">\n"
+    )
+    if head and head.title:
+        text += f"<title>{escape(head.title)}</title>\n"
+    if head and head.desc:
+        text += f"<desc>{escape(head.desc)}</desc>\n"
+    return text
+
+
+class _Uses:
+    """Per instance: the key of its ``<use>`` format; per key: its format pieces."""
+
+    def __init__(self, key: np.ndarray, pieces: list[tuple[str, str, tuple[float, ...]]]) -> None:
+        self.key = key
+        self.pieces = pieces  # (href id, style template, stroke lengths in canvas units)
+
+
+def _lengths_of(decls: dict[str, str]) -> list[tuple[str, list[float]]] | None:
+    """Return the stroke lengths of declarations (canvas units) by key, or None if one is unreadable."""
+    out = []
+    for key in _LENGTH_KEYS:
+        if key not in decls:
+            continue
+        parts = [p for p in re.split(r"[\s,]+", decls[key].strip()) if p]
+        values = [_length(p) for p in parts]
+        if not values or any(v is None for v in values):
+            return None
+        out.append((key, [float(v) for v in values if v is not None]))
+    return out
+
+
+def _stroked(decls: dict[str, str]) -> dict[str, str]:
+    """Declarations with the default stroke width written out when the style strokes."""
+    if decls.get("stroke", "none").strip().lower() not in ("none", "") and "stroke-width" not in decls:
+        return {**decls, "stroke-width": "1"}
+    return decls
+
+
+def _uses(drawing, symbol, style, styles, scale, plain, ids: _Ids) -> tuple[_Uses, list[str]]:
+    """Choose each terminal's definition and each instance's ``<use>`` format (style part)."""
+    n = symbol.size
+    key = np.zeros(n, np.intp)
+    pieces: list[tuple[str, str, tuple[float, ...]]] = []
+    defs: list[str] = []
+    decls = [_stroked(css_decls(s)) for s in styles]
+    for t in np.unique(symbol[plain]).tolist() if n else []:
+        mine = np.flatnonzero(plain & (symbol == t))
+        used_styles = np.unique(style[mine]).tolist()
+        factor = scale[mine]
+        constant = bool(np.ptp(factor) <= 1e-12 * max(1.0, float(np.abs(factor).max())))
+        finals = [_scaled(decls[s], float(factor[0])) if constant else decls[s] for s in used_styles]
+        common = dict(finals[0])
+        for d in finals[1:]:
+            common = {k: v for k, v in common.items() if d.get(k) == v}
+        if not constant or any(_lengths_of(d) is None for d in finals):
+            common = {k: v for k, v in common.items() if k not in _LENGTH_KEYS}
+        term = drawing.terminals[t]
+        ref = ids.get(term.name)
+        defs.append(_definition(term.path, ref, common, any(k in d for d in finals for k in _PATH_ONLY)))
+        for s, d in zip(used_styles, finals, strict=True):
+            rest = {k: v for k, v in d.items() if k not in common}
+            template, lengths = _template(rest, varying=not constant)
+            key[mine[style[mine] == s]] = len(pieces)
+            pieces.append((ref, template, lengths))
+    return _Uses(key, pieces), defs
+
+
+def _scaled(decls: dict[str, str], factor: float) -> dict[str, str]:
+    """Declarations with their stroke lengths multiplied by ``factor`` (canvas units to local)."""
+    lengths = _lengths_of(decls)
+    if not lengths or factor == 1.0:
+        return decls
+    out = dict(decls)
+    for key, values in lengths:
+        out[key] = " ".join(f"{v * factor:.{DIGITS}g}" for v in values)
+    return out
+
+
+def _template(decls: dict[str, str], varying: bool) -> tuple[str, tuple[float, ...]]:
+    """Return the ``style`` attribute template of a ``<use>`` and the lengths it takes (canvas units)."""
+    if not decls:
+        return "", ()
+    lengths = _lengths_of(decls) if varying else None
+    if not lengths:
+        return f' style="{_attr(css_text(decls)).replace("%", "%%")}"', ()
+    out = dict(decls)
+    flat: list[float] = []
+    for key, values in lengths:
+        out[key] = " ".join(["\0"] * len(values))
+        flat += values
+    return f' style="{_attr(css_text(out)).replace("%", "%%").replace(chr(0), _NUM)}"', tuple(flat)
+
+
+def _definition(path: str, ref: str, common: dict[str, str], path_only: bool) -> str:
+    """Return a terminal's element for ``<defs>``."""
+    style = f' style="{_attr(css_text(common))}"' if common else ""
+    shape = None if path_only else primitive(path)
+    if shape is None:
+        return f'<path id="{_attr(ref)}" d="{_attr(_compact(path))}"{style}/>\n'
+    tag, attrs = shape
+    text = " ".join(f'{k}="{_attr(v)}"' for k, v in attrs.items())
+    return f'<{tag} id="{_attr(ref)}" {text}{style}/>\n'
+
+
+def _compact(d: str) -> str:
+    """Return path data with its numbers rounded to :data:`PATH_PRECISION` of the shape's size.
+
+    Path data with arcs is left as it is (their flags may be written without separators).
+    """
+    if "a" in d.lower():
+        return d
+    try:
+        cubics = shape_arrays(d)[0]
+    except LsysError:
+        return d
+    if cubics.size == 0 or not np.isfinite(cubics).all():
+        return d
+    size = float(max(np.ptp(cubics.real), np.ptp(cubics.imag), np.abs(cubics).max()))
+    if size <= 0:
+        return d
+    decimals = max(0, -math.floor(math.log10(size * PATH_PRECISION)))
+
+    def fix(mt: re.Match) -> str:
+        text = f"{round(float(mt.group()), decimals):.{decimals}f}"
+        if "." in text:
+            text = text.rstrip("0").rstrip(".")
+        return "0" if text in ("-0", "") else text
+
+    return _NUMBER.sub(fix, d)
+
+
+def _values(a, b, scale, uses: _Uses, drawing) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Return the numbers of every ``<use>`` (a mask says which its format takes) and the formats."""
+    n = a.size
+    vb = _canvas(drawing)[0]
+    size = max(abs(vb[2]), abs(vb[3]), 1e-300)
+    s = np.abs(a)
+    deg = np.degrees(np.angle(a))
+    deg = np.where(deg <= -180.0, deg + 360.0, deg)
+    tx = np.where(np.abs(b.real) <= 1e-9 * size, 0.0, b.real)
+    ty = np.where(np.abs(b.imag) <= 1e-9 * size, 0.0, b.imag)
+    kinds = (
+        ((tx != 0) | (ty != 0)).astype(np.intp) * 4
+        + (np.abs(deg) > 1e-9).astype(np.intp) * 2
+        + (np.abs(s - 1.0) > 1e-12).astype(np.intp)
+    )
+    width = max((len(p[2]) for p in uses.pieces), default=0)
+    values = np.zeros((n, 4 + width))
+    values[:, 0], values[:, 1], values[:, 2], values[:, 3] = tx, ty, deg, s
+    used = np.zeros((n, 4 + width), bool)
+    used[:, 0] = used[:, 1] = kinds >= 4
+    used[:, 2] = (kinds & 2) > 0
+    used[:, 3] = (kinds & 1) > 0
+    if width:
+        table = np.zeros((len(uses.pieces), width))
+        count = np.zeros(len(uses.pieces), np.intp)
+        for i, (_, _, lengths) in enumerate(uses.pieces):
+            table[i, : len(lengths)] = lengths
+            count[i] = len(lengths)
+        with np.errstate(invalid="ignore", over="ignore"):
+            values[:, 4:] = table[uses.key] * scale[:, None]
+        used[:, 4:] = np.arange(width)[None, :] < count[uses.key][:, None]
+    combined = uses.key * 8 + kinds
+    keys, inverse = np.unique(combined, return_inverse=True)
+    uses.key = inverse.reshape(-1)
+    formats = []
+    for c in keys.tolist():
+        ref, template, _ = uses.pieces[c // 8]
+        kind = c % 8
+        transform = " ".join(
+            t
+            for t, on in (
+                (f"translate({_NUM} {_NUM})", kind >= 4),
+                (f"rotate({_NUM})", kind & 2),
+                (f"scale({_NUM})", kind & 1),
+            )
+            if on
+        )
+        tattr = f' transform="{transform}"' if transform else ""
+        formats.append(f'<use href="#{_attr(ref).replace("%", "%%")}"{tattr}{template}/>\n')
+    return values, used, formats
+
+
+def _display_groups(calls: Calls) -> np.ndarray:
+    """Return, for every call, the call whose group holds it: itself, or the call its sequence continues."""
+    k = len(calls.rule)
+    parent = np.asarray(calls.parent, np.int64)
+    merge = np.asarray(calls.continues, bool) & (parent >= 0)
+    rep = np.where(merge, np.where(parent >= 0, parent, 0), np.arange(k))
+    while True:
+        nxt = rep[rep]
+        if np.array_equal(nxt, rep):
+            return rep
+        rep = nxt
+
+
+def _grouped(parts: np.ndarray, calls: Calls | None, extra: dict[int, str], ids: _Ids) -> str:
+    """Join the instances' ``<use>`` templates, with a ``<g>`` per call around them and verbatim content."""
+    n = len(parts)
+    if calls is None or len(calls.rule) <= 1:
+        group = np.zeros(n, np.intp)
+        rep = np.zeros(1, np.intp)
+    else:
+        rep = _display_groups(calls)
+        group = rep[np.asarray(calls.call, np.intp)]
+    parent = np.asarray(calls.parent, np.int64) if calls is not None else np.full(1, -1)
+    cuts = np.flatnonzero(np.r_[True, group[1:] != group[:-1]]) if n else np.zeros(0, np.intp)
+    cuts = np.union1d(cuts, [k for k in extra if 0 < k < n]).astype(np.intp)
+    chains: dict[int, tuple[int, ...]] = {0: ()}
+    names: dict[int, str] = {}
+    opened: dict[int, int] = {}
+    per_rule: dict[str, int] = {}
+    out: list[str] = []
+    stack: list[int] = []
+    for s, e in zip(cuts.tolist(), [*cuts[1:].tolist(), n], strict=True):
+        chain = _chain(int(group[s]), rep, parent, chains)[:MAX_DEPTH]
+        keep = 0
+        while keep < min(len(stack), len(chain)) and stack[keep] == chain[keep]:
+            keep += 1
+        while len(stack) > keep:
+            out.append("</g>\n")
+            stack.pop()
+        for node in chain[keep:]:
+            rule = calls.rule[node] if calls is not None else ""
+            if node not in names:
+                per_rule[rule] = per_rule.get(rule, 0) + 1
+                names[node] = ids.get(f"{rule}-{per_rule[rule]}")
+                gid = names[node]
+            else:
+                opened[node] = opened.get(node, 1) + 1
+                gid = ids.get(f"{names[node]}.{opened[node]}")
+            out.append(f'<g id="{_attr(gid)}" data-rule="{_attr(rule)}">\n'.replace("%", "%%"))
+            stack.append(node)
+        out.append(extra.get(s, ""))
+        out.append("".join(parts[s:e].tolist()))
+    out.append("</g>\n" * len(stack))
+    out.append(extra.get(n, ""))
+    return "".join(out)
+
+
+def _chain(
+    node: int, rep: np.ndarray, parent: np.ndarray, chains: dict[int, tuple[int, ...]]
+) -> tuple[int, ...]:
+    """Return the groups from the top down to ``node`` (the axiom, call 0, has none)."""
+    path = []
+    while node not in chains:
+        path.append(node)
+        node = int(rep[parent[node]])
+    chain = chains[node]
+    for p in reversed(path):
+        chain = (*chain, p)
+        chains[p] = chain
+    return chain
