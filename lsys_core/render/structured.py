@@ -5,9 +5,10 @@ A designer who opens the file sees what repeats:
 - every terminal is written once, in ``<defs>``, with its name as ``id`` (``A``, ``leaf``);
   a terminal that is a circle, an ellipse, a rectangle or a line is written as that element
   (:func:`~lsys_core.render.primitives.primitive`);
-- every instance is a ``<use href="#A" transform="…">`` (a clone in Inkscape: edit the shape
-  once, every copy follows), with ``translate``/``rotate``/``scale`` written only where they
-  are not the identity;
+- every instance is a ``<use xlink:href="#A" transform="…">`` (a clone in Inkscape: edit the
+  shape once, every copy follows), with ``translate``/``rotate``/``scale`` written only where
+  they are not the identity.  ``xlink:href`` rather than SVG 2's plain ``href``: Inkscape 1.2
+  draws nothing for a plain ``href``, and every SVG 2 reader still reads ``xlink:href``;
 - every rule call is a ``<g id="P1-1" data-rule="P1" data-m="7">`` around what it drew, nested
   as the calls nest (:class:`~lsys_core.derive.model.Calls`): the layers panel shows the
   hierarchy and selecting a group selects one call (a row of windows, one flower).  The
@@ -79,7 +80,7 @@ def drawing_to_structured_svg(drawing: Drawing, *, head=None) -> str:
     n = len(drawing)
     extra_xml = drawing.defs + "".join(v.xml for v in drawing.verbatim)
     ids = _Ids(_ID.findall(extra_xml) + [v for k, v in (head.attributes if head else ()) if k == "id"])
-    out = [_root(drawing, head, "xlink:" in extra_xml)]
+    out = [_root(drawing, head)]
     symbol = np.asarray(drawing.symbol, np.intp).reshape(n)
     a = np.asarray(drawing.a, complex).reshape(n)
     b = np.asarray(drawing.b, complex).reshape(n)
@@ -128,11 +129,9 @@ class _Ids:
         return name
 
 
-def _root(drawing: Drawing, head, xlink: bool) -> str:
+def _root(drawing: Drawing, head) -> str:
     vb, size = _canvas(drawing)
-    attrs = [("xmlns", "http://www.w3.org/2000/svg")]
-    if xlink:
-        attrs.append(("xmlns:xlink", _XLINK))
+    attrs = [("xmlns", "http://www.w3.org/2000/svg"), ("xmlns:xlink", _XLINK)]
     kept = list(head.attributes) if head else []
     attrs += [kv for kv in kept if kv[0].startswith("xmlns:") and kv[1] != _XLINK]
     attrs += [("width", size[0]), ("height", size[1]), ("viewBox", " ".join(f"{v:.{DIGITS}g}" for v in vb))]
@@ -240,7 +239,10 @@ def _definition(path: str, ref: str, common: dict[str, str], path_only: bool) ->
     if shape is None:
         return f'<path id="{_attr(ref)}" d="{_attr(_compact(path))}"{style}/>\n'
     tag, attrs = shape
-    text = " ".join(f'{k}="{_attr(v)}"' for k, v in attrs.items())
+    # position attributes are 0 by default
+    text = " ".join(
+        f'{k}="{_attr(v)}"' for k, v in attrs.items() if not (k in ("x", "y", "cx", "cy") and v == "0")
+    )
     return f'<{tag} id="{_attr(ref)}" {text}{style}/>\n'
 
 
@@ -319,7 +321,7 @@ def _values(a, b, scale, uses: _Uses, drawing) -> tuple[np.ndarray, np.ndarray, 
             if on
         )
         tattr = f' transform="{transform}"' if transform else ""
-        formats.append(f'<use href="#{_attr(ref).replace("%", "%%")}"{tattr}{template}/>\n')
+        formats.append(f'<use xlink:href="#{_attr(ref).replace("%", "%%")}"{tattr}{template}/>\n')
     return values, used, formats
 
 

@@ -33,6 +33,7 @@ from .shared import REALWORLD, ROOT, need
 etree = pytest.importorskip("lxml.etree", reason="lxml is in the test extra")
 
 SVG_NS = "http://www.w3.org/2000/svg"
+XLINK_NS = "http://www.w3.org/1999/xlink"
 EXAMPLES = sorted((ROOT / "resources" / "examples").glob("*.lsys"))
 
 
@@ -138,7 +139,7 @@ def check_document(svg: str) -> list[tuple[str, str, int]]:
     assert len(ids) == len(set(ids)), [k for k, v in Counter(ids).items() if v > 1]
     defs = {el.get("id") for d in root.iter(f"{{{SVG_NS}}}defs") for el in d.iter() if el.get("id")}
     for use in root.iter(f"{{{SVG_NS}}}use"):
-        href = use.get("href") or use.get("{http://www.w3.org/1999/xlink}href")
+        href = use.get(f"{{{XLINK_NS}}}href") or use.get("href")
         assert href and href.startswith("#") and href[1:] in defs, href
     found = []
     for g in root.iter(f"{{{SVG_NS}}}g"):
@@ -298,7 +299,7 @@ def test_interleaved_paint_order_splits_groups_and_keeps_ids_unique() -> None:
     svg = drawing_to_structured_svg(drawing)
     found = check_document(svg)
     assert {rule for rule, _, _ in found} == {"P", "Q"} and len(found) > 2
-    order = [u.get("href") for u in parse(svg).iter(f"{{{SVG_NS}}}use")]
+    order = [u.get(f"{{{XLINK_NS}}}href") for u in parse(svg).iter(f"{{{SVG_NS}}}use")]
     symbols = [drawing.terminals[s].name for s in drawing.symbol.tolist()]
     assert order == [f"#{s}" for s in symbols]  # the paint order is the drawing's
 
@@ -387,3 +388,16 @@ def test_defs_verbatim_and_url_styles_are_carried_through() -> None:
     assert body.count("url(#g)") == 3
     assert len(list(root.iter(f"{{{SVG_NS}}}use"))) == 6
     assert [local(el) for el in root.find(f"{{{SVG_NS}}}defs") if el.get("id") != "g"] == ["circle"]
+
+
+@pytest.mark.skipif(shutil.which("inkscape") is None, reason="needs Inkscape")
+def test_inkscape_sees_the_groups_and_the_clones(tmp_path) -> None:
+    g = parse_grammar((ROOT / "resources" / "examples" / "facade.lsys").read_text(encoding="utf-8"))
+    drawing = derive(g)
+    out = tmp_path / "facade.svg"
+    out.write_text(drawing_to_structured_svg(drawing), encoding="utf-8")
+    p = subprocess.run(["inkscape", "--query-all", str(out)], capture_output=True, text=True, timeout=300)
+    ids = [line.split(",")[0] for line in p.stdout.splitlines()]
+    found = check_document(out.read_text(encoding="utf-8"))
+    assert sum(i.startswith(("P1-", "P2-", "X1-", "Z-")) for i in ids) == len(found)  # every group
+    assert sum(i.startswith("use") for i in ids) == len(drawing)  # every clone, with its bounding box
