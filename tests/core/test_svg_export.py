@@ -13,7 +13,7 @@ from lsys_core.derive.model import Drawing
 from lsys_core.errors import LsysError
 from lsys_core.geometry import cubics_from_d, d_from_cubics, sample_cubics, sample_uniform
 from lsys_core.grammar.model import Terminal
-from lsys_core.render import drawing_bounds, drawing_to_svg, export_svg
+from lsys_core.render import drawing_bounds, drawing_to_structured_svg, drawing_to_svg, export_svg
 from lsys_core.svg import load_svg, parse_svg
 
 from .scenes import make_drawing
@@ -202,6 +202,8 @@ def test_export_svg_writes_atomically(tmp_path):
     out = tmp_path / "out.svg"
     out.write_text("old")
     export_svg(dr, out)
+    assert out.read_text() == drawing_to_structured_svg(dr)
+    export_svg(dr, out, flat=True)
     assert out.read_text() == drawing_to_svg(dr)
     with pytest.raises(LsysError, match="cannot write"):
         export_svg(dr, tmp_path / "missing" / "out.svg")
