@@ -44,6 +44,9 @@ def main() -> None:
             except LsysError as exc:
                 print(f"  {path.name:<38} skipped: {exc}")
                 continue
+            except Exception as exc:  # a bug elsewhere must not hide the other files' figures
+                print(f"  {path.name:<38} skipped: internal error {type(exc).__name__}: {exc}")
+                continue
             t = time.perf_counter()
             flat = len(drawing_to_svg(drawing).encode("utf-8"))
             structured = len(drawing_to_structured_svg(drawing, head=read_head(data)).encode("utf-8"))
