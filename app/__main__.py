@@ -1,4 +1,4 @@
-"""Start the editor: ``lsys-editor [FILE.svg|FILE.lsys] [--screenshot OUT.png]``.
+"""Start the editor: ``lsys-editor [FILE.svg|FILE.lsys] [--screenshot OUT.png [steps]]``.
 
 ``--help`` and ``--version`` answer before Qt is loaded (they work without a display or Qt).
 
@@ -30,6 +30,23 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", nargs="?", help="an SVG to analyse, or an .lsys rules file")
     p.add_argument("--screenshot", metavar="OUT.png", help="save a PNG of the window once ready, then exit")
     p.add_argument("--size", default="1400x900", help="window size for --screenshot (default 1400x900)")
+    shot = p.add_argument_group("screenshot steps (run in this order before the picture is taken)")
+    shot.add_argument(
+        "--show",
+        default="",
+        metavar="PANELS",
+        help="raise these docks: rules, cards, params, inference, structure",
+    )
+    shot.add_argument(
+        "--color-by", default="", choices=("", "rule", "group"), help="colour the canvas by rule or group"
+    )
+    shot.add_argument(
+        "--select", type=int, metavar="N", help="click instance N (its repetition shows handles)"
+    )
+    shot.add_argument(
+        "--drag", default="", metavar="DX,DY", help="drag the next-repetition handle by DX,DY pixels"
+    )
+    shot.add_argument("--scale", type=float, metavar="F", help="device pixel ratio (QT_SCALE_FACTOR), e.g. 2")
     p.add_argument(
         "--timeout",
         type=float,
@@ -79,67 +96,6 @@ def _offer_recovery(window) -> None:
         discard_orphan(path)
 
 
-def _screenshot(app, window, out: str, timeout: float) -> int:
-    """Wait until the window is idle, save a PNG of it, return the exit status."""
-    from PySide6.QtCore import QBuffer, QByteArray, QIODevice, QTimer
-
-    from lsys_core.errors import LsysError
-
-    from . import core
-
-    status = {"code": 1, "done": False}
-    errors: list[str] = []
-    window.doc.message.connect(errors.append)
-    window.canvas.message.connect(errors.append)
-
-    def finish(code: int, message: str = "") -> None:
-        if status["done"]:
-            return
-        status["done"] = True
-        status["code"] = code
-        if message:
-            print(f"lsys-editor: {message}", file=sys.stderr)
-        app.quit()
-
-    def shoot() -> None:
-        if status["done"]:
-            return
-        if window.doc.drawing is None:
-            finish(1, errors[-1] if errors else "nothing was derived")
-            return
-        pixmap = window.grab()
-        data = QByteArray()
-        buf = QBuffer(data)
-        buf.open(QIODevice.OpenModeFlag.WriteOnly)
-        if not pixmap.save(buf, "PNG"):
-            finish(1, "could not encode the screenshot")
-            return
-        try:
-            core.write_atomic(out, bytes(data.data()))
-        except LsysError as exc:
-            finish(1, str(exc))
-            return
-        for e in errors:
-            print(f"lsys-editor: note: {e}", file=sys.stderr)
-        finish(0)
-
-    idle_polls = {"n": 0}
-
-    def poll() -> None:
-        idle_polls["n"] = idle_polls["n"] + 1 if window.is_idle() else 0
-        if idle_polls["n"] >= 3:
-            shoot()
-
-    timer = QTimer(window)
-    timer.setInterval(50)
-    timer.timeout.connect(poll)
-    timer.start()
-    QTimer.singleShot(int(timeout * 1000), lambda: finish(1, f"not ready after {timeout:g} s"))
-    app.exec()
-    timer.stop()
-    return status["code"]
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the editor; return the process exit status."""
     import multiprocessing
@@ -158,10 +114,13 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     QCoreApplication.setOrganizationName("lsys-editor")
     QCoreApplication.setApplicationName("lsys-editor")
+    if args.scale:
+        os.environ["QT_SCALE_FACTOR"] = f"{args.scale:g}"  # read when the application starts
     app = QApplication.instance() or QApplication([sys.argv[0]])
     _set_identity(app)
 
     from .main_window import MainWindow
+    from .screenshot import steps_from_args, take_screenshot
 
     if args.file and not os.path.isfile(args.file):
         print(f"lsys-editor: no such file: {args.file}", file=sys.stderr)
@@ -179,7 +138,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         window.open_path(args.file)
     try:
         if screenshot:
-            code = _screenshot(app, window, args.screenshot, args.timeout)
+            steps = steps_from_args(window, args.show, args.color_by, args.select, args.drag)
+            code = take_screenshot(app, window, args.screenshot, args.timeout, steps)
             window.doc.undo_stack.setClean()  # a screenshot run never asks to save
             window.close()
             return code

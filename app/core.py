@@ -144,11 +144,11 @@ def find_handles(grammar: Any, drawing: Any, index: int, knob: float) -> Any:
     return _find(grammar, drawing, index, knob)
 
 
-def handle_values(handles: Any, which: str, point: complex) -> dict[str, float]:
+def handle_values(handles: Any, which: str, point: complex, pixel: float = 0.0) -> dict[str, float]:
     """Return control values for handle ``which`` dragged to ``point`` (``drag_values``)."""
     from lsys_core.derive.handles import drag_values
 
-    return drag_values(handles, which, point)
+    return drag_values(handles, which, point, pixel)
 
 
 def snap(value: float, tolerance: float, kind: str, *, ring: int | None = None) -> float:

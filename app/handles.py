@@ -206,7 +206,8 @@ class HandleEditor(QObject):
         h = self.overlay.frozen()
         if h is None:
             return
-        values = self._values(h.rule, core.handle_values(h, which, complex(x, y)))
+        pixel = 1.0 / self.overlay.canvas.view.zoom  # one logical screen pixel in drawing units
+        values = self._values(h.rule, core.handle_values(h, which, complex(x, y), pixel))
         if values:
             what = {"move": "step", "turn": "turn per step", "scale": "scale per step", "radius": "radius"}[
                 which

@@ -28,6 +28,7 @@ import numpy as np
 from lsys_core.derive.model import Drawing
 from lsys_core.grammar.model import Grammar, Symbol, Turtle
 from lsys_core.grammar.semantics import Card, describe
+from lsys_core.grammar.snap import snap
 
 __all__ = ["Handles", "drag_values", "find_handles"]
 
@@ -203,13 +204,36 @@ def _anchor(g: Grammar, drawing: Drawing, index: int, own: str) -> tuple[complex
     return complex(drawing.a[j]), complex(drawing.b[j])
 
 
-def drag_values(h: Handles, which: str, point: complex) -> dict[str, float]:
+def drag_values(h: Handles, which: str, point: complex, pixel: float = 0.0) -> dict[str, float]:
     """Return new values of the rule's controls (by label) for handle ``which`` dragged to ``point``.
 
     ``move`` sets step distance (and direction when the rule has one), ``turn`` the turn per
     step (or the direction when the rule turns only before its move), ``scale`` the scale per
     step, ``radius`` the step distance that gives a ring of the new radius.
+
+    ``pixel`` is the size of one screen pixel in drawing units: each value is snapped to the
+    simplest number that moves the dragged point by less than half a pixel
+    (:func:`lsys_core.grammar.snap.snap`), so a drag writes ``46``, not ``45.9731``.
     """
+    out = _raw_drag_values(h, which, point)
+    if pixel > 0.0:
+        out = {k: _snap_drag(k, v, h, which, point, pixel) for k, v in out.items()}
+    return {k: v for k, v in out.items() if k in h.controls}
+
+
+def _snap_drag(label: str, value: float, h: Handles, which: str, point: complex, pixel: float) -> float:
+    """``value`` snapped within what half a screen pixel at the dragged point can tell."""
+    half = 0.5 * pixel
+    if label.endswith("scale"):
+        return snap(value, half / max(abs(point - h.b1), 1e-12), "scale")
+    if label.endswith(("direction", "turn")):
+        arm = abs(point - (h.b0 if which == "move" else h.b1))
+        return snap(value, math.degrees(half / max(arm, 1e-12)), "angle")
+    return snap(value, half / max(abs(h.a0), 1e-12), "distance")
+
+
+def _raw_drag_values(h: Handles, which: str, point: complex) -> dict[str, float]:
+    """The exact control values a drag of handle ``which`` to ``point`` asks for."""
     out: dict[str, float] = {}
     if which == "move":
         local = (point - h.b0) / h.a0
@@ -226,4 +250,4 @@ def drag_values(h: Handles, which: str, point: complex) -> dict[str, float]:
         old = abs(h.b0 - h.center)
         if old > 0:
             out["step distance"] = abs(h.b1 - h.b0) / abs(h.a0) * abs(point - h.center) / old
-    return {k: v for k, v in out.items() if k in h.controls}
+    return out

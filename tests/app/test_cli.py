@@ -54,3 +54,20 @@ def test_screenshot_of_unreadable_svg_fails_with_message(tmp_path):
     proc = _run(str(bad), "--screenshot", str(tmp_path / "x.png"))
     assert proc.returncode == 1
     assert "bad.svg" in proc.stderr
+
+
+def test_screenshot_runs_steps_then_exits_without_asking_to_save(tmp_path):
+    """Steps edit the rules (a handle drag); the run still ends by itself with a picture."""
+    out = tmp_path / "drag.png"
+    example = ROOT / "resources" / "examples" / "facade.svg"
+    args = ("--size", "1000x700", "--show", "cards,structure", "--select", "3", "--drag", "40,0")
+    proc = _run(str(example), "--screenshot", str(out), *args, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert out.stat().st_size > 0
+
+
+def test_screenshot_step_arguments_are_checked(tmp_path):
+    example = ROOT / "resources" / "examples" / "facade.svg"
+    proc = _run(str(example), "--screenshot", str(tmp_path / "x.png"), "--show", "nope")
+    assert proc.returncode != 0 and "--show takes" in proc.stderr
+    assert not (tmp_path / "x.png").exists()

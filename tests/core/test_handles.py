@@ -97,3 +97,15 @@ def test_a_window_of_a_facade_is_repeated_by_its_row_and_groups_have_no_handles(
     assert h.rule == "P1" and abs(h.b1 - h.b0) == pytest.approx(60)
     door = int(np.flatnonzero(d.symbol == names.index("B"))[0])
     assert find_handles(g, d, door, knob=5.0) is None
+
+
+def test_drag_writes_the_simplest_value_half_a_pixel_can_tell():
+    g = parse_grammar(HELIX)
+    h = find_handles(g, derive(g), 5, knob=10.0)
+    nudge = (h.b1 - h.b0) * 1.0003  # the next repetition dragged a hair past where it was
+    raw = drag_values(h, "move", h.b0 + nudge)
+    snapped = drag_values(h, "move", h.b0 + nudge, pixel=1.0)
+    assert raw["step distance"] != pytest.approx(24.0, abs=1e-6)  # the raw drag carries the noise
+    assert snapped["step distance"] == 24.0
+    fine = drag_values(h, "move", h.b0 + nudge, pixel=1e-6)  # zoomed far in: every digit counts
+    assert fine["step distance"] == pytest.approx(raw["step distance"], abs=1e-6)
