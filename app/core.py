@@ -60,6 +60,20 @@ def infer(scene: Any, settings: Any, *, cancel=None, progress=None) -> Any:
     return _infer(scene, settings, cancel=cancel, progress=progress)
 
 
+def analyse(scene: Any, settings: Any, *, previous=None, cancel=None, progress=None) -> Any:
+    """Analyse ``scene`` once for any weights (``lsys_core.pipeline.analyse``)."""
+    from lsys_core.pipeline import analyse as _analyse
+
+    return _analyse(scene, settings, previous=previous, cancel=cancel, progress=progress)
+
+
+def rules_from_analysis(analysis: Any, *, cancel=None, progress=None) -> Any:
+    """Rules for the analysis' settings (``lsys_core.pipeline.rules_from_analysis``)."""
+    from lsys_core.pipeline import rules_from_analysis as _rules
+
+    return _rules(analysis, cancel=cancel, progress=progress)
+
+
 def symmetrize(scene: Any, settings: Any, *, cancel=None, progress=None) -> Any:
     """Infer with relaxed clustering tolerance (``lsys_core.pipeline.symmetrize``)."""
     from lsys_core.pipeline import symmetrize as _sym
