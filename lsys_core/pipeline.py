@@ -19,8 +19,9 @@ from lsys_core.derive.model import Drawing
 from lsys_core.errors import InferenceError
 from lsys_core.grammar.model import Grammar
 from lsys_core.hierarchy.cache import LevelCache
+from lsys_core.hierarchy.describe import flat_bits, grammar_bits
 from lsys_core.hierarchy.explain import explained_share
-from lsys_core.hierarchy.mdl import Precision, flat_bits, grammar_bits
+from lsys_core.hierarchy.mdl import Precision
 from lsys_core.hierarchy.pivots import estimate_pivots, recenter
 from lsys_core.hierarchy.postprocess import simplify
 from lsys_core.hierarchy.rules import Hierarchy, Tolerance, Weights, build_hierarchy
@@ -28,6 +29,7 @@ from lsys_core.hierarchy.snap import SHARE
 from lsys_core.instancing.fidelity import split_unfaithful
 from lsys_core.instancing.model import Instancing
 from lsys_core.instancing.orientation import unwrap_symmetric
+from lsys_core.report import bounds, deviation, element_circles, measurer, reproduction_error
 from lsys_core.settings import SETTINGS, setting
 from lsys_core.settings import check as check_setting
 from lsys_core.svg.model import Scene
@@ -149,18 +151,6 @@ class InferenceResult:
     description_bits: tuple[float, float] = (0.0, 0.0)
 
 
-def _element_circles(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
-    """Return the centre and radius of every element's control polygon (vectorised)."""
-    sizes = np.array([e.cubics.shape[0] for e in scene.elements])
-    pts = np.concatenate([e.cubics.reshape(-1) for e in scene.elements])
-    owner = np.repeat(np.arange(sizes.size), sizes * 4)
-    cnt = np.bincount(owner, minlength=sizes.size)
-    cen = (np.bincount(owner, pts.real, sizes.size) + 1j * np.bincount(owner, pts.imag, sizes.size)) / cnt
-    rad = np.zeros(sizes.size)
-    np.maximum.at(rad, owner, np.abs(pts - cen[owner]))
-    return cen, rad
-
-
 def _shape_similarity(inst: Instancing, cancel: CancelToken | None) -> np.ndarray:
     """Similarity of pairs of terminals for the importance's φ (§5.4, mirror images count as alike)."""
     from lsys_core.instancing.similarity import terminal_similarity
@@ -169,12 +159,6 @@ def _shape_similarity(inst: Instancing, cancel: CancelToken | None) -> np.ndarra
         k = len(inst.terminals)
         return np.full((k, k), 0.5) + 0.5 * np.eye(k)
     return terminal_similarity(inst.terminals, cancel=cancel)
-
-
-def _bounds(scene: Scene) -> tuple[complex, complex]:
-    """Corners of the bounding box of all control points (it holds every outline)."""
-    pts = np.concatenate([e.cubics.reshape(-1) for e in scene.elements])
-    return complex(pts.real.min(), pts.imag.min()), complex(pts.real.max(), pts.imag.max())
 
 
 def _factors(settings: InferenceSettings, symmetrizing: bool, n: int) -> list[float]:
@@ -190,82 +174,6 @@ def _factors(settings: InferenceSettings, symmetrizing: bool, n: int) -> list[fl
     else:
         steps = (1.0, 5.0)
     return [settings.tolerance * f for f in steps]
-
-
-def _matched(inst: Instancing, sizes: np.ndarray, drawing) -> tuple[np.ndarray, np.ndarray] | None:
-    """The derived pose matched to every input element, or None when instances are missing.
-
-    Each input element is matched to the nearest derived instance of its terminal (by
-    position, and by rotation and scale at the shape's radius: copies turned about one point
-    share their position).
-    """
-    from scipy.spatial import cKDTree
-
-    a_out = np.zeros_like(inst.a)
-    b_out = np.zeros_like(inst.b)
-    for g in range(len(inst.terminals)):
-        mine = np.flatnonzero(inst.group == g)
-        theirs = np.flatnonzero(drawing.symbol == g)
-        if mine.size != theirs.size:
-            return None
-        if mine.size == 0:
-            continue
-
-        def poses(a: np.ndarray, b: np.ndarray, size: float = float(sizes[g])) -> np.ndarray:
-            return np.column_stack([b.real, b.imag, size * a.real, size * a.imag])
-
-        ta, tb = drawing.a[theirs], drawing.b[theirs]
-        _, j = cKDTree(poses(ta, tb)).query(poses(inst.a[mine], inst.b[mine]))
-        a_out[mine], b_out[mine] = ta[j], tb[j]
-    return a_out, b_out
-
-
-def _displacements(inst: Instancing, sizes: np.ndarray, drawing) -> np.ndarray:
-    """How far every input element's pose moved in ``drawing`` (translation plus turn/scale at its reach)."""
-    matched = _matched(inst, sizes, drawing)
-    if matched is None:
-        return np.full(inst.a.size, np.inf)
-    a, b = matched
-    return np.abs(inst.b - b) + sizes[inst.group] * np.abs(inst.a - a)
-
-
-def reproduction_error(inst: Instancing, sizes: np.ndarray, drawing) -> float:
-    """Largest displacement of an input element's pose in ``drawing`` (document units; inf if one is missing)."""
-    d = _displacements(inst, sizes, drawing)
-    return float(d.max()) if d.size else 0.0
-
-
-def _deviation(
-    inst: Instancing, sizes: np.ndarray, drawing, shape_dev: np.ndarray, limit: float, measure
-) -> float:
-    """Largest distance of a derived element from its input element (document units).
-
-    The shape's deviation plus its pose's displacement bounds it; where that bound exceeds
-    ``limit``, the derived outline is measured.
-    """
-    matched = _matched(inst, sizes, drawing)
-    if matched is None:
-        return float("inf")
-    a, b = matched
-    bound = shape_dev + np.abs(inst.b - b) + sizes[inst.group] * np.abs(inst.a - a)
-    over = np.flatnonzero(bound > limit)
-    if over.size:
-        bound[over] = measure(over, a[over], b[over])
-    return float(bound.max()) if bound.size else 0.0
-
-
-def _measure(scene: Scene, inst: Instancing):
-    """``measure(elements, a, b)``: the deviation of input elements from their terminals at poses ``a, b``."""
-    from lsys_core.geometry.shapes import shape_arrays
-    from lsys_core.instancing.deviation import pose_deviations
-    from lsys_core.svg.model import Element
-
-    shapes = [Element(*shape_arrays(t.path)) for t in inst.terminals]
-
-    def measure(elements: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        return pose_deviations([scene.elements[i] for i in elements], shapes, inst.group[elements], a, b)
-
-    return measure
 
 
 def _instancing(scene: Scene, settings: InferenceSettings, tolerance: float, cancel, progress) -> Instancing:
@@ -378,8 +286,8 @@ def analyse(
         same = previous.settings.neighbours == settings.neighbours
         return replace(previous, settings=settings, levels=previous.levels if same else LevelCache())
     stages: dict[str, float] = {}
-    center, radius = _element_circles(scene)
-    box = _bounds(scene)
+    center, radius = element_circles(scene)
+    box = bounds(scene)
     diag = max(abs(box[1] - box[0]), 1e-12)
     eps = DEFAULT_DEVIATION * diag if settings.deviation is None else settings.deviation
     eps = max(eps, EXACT_PLACEMENT * diag)  # 0: exact copies, placed as precisely as SVG writes them
@@ -439,7 +347,7 @@ def rules_from_analysis(
     limit = max(prec.eps, SYMMETRIZE_ERROR * diag) if symmetrizing else prec.eps
     shape_dev = inst.deviation if inst.deviation is not None else np.zeros(inst.a.size)
     slack = np.maximum(limit - shape_dev, 0.0)
-    measure = _measure(scene, inst)
+    measure = measurer(scene, inst)
     best: tuple[Grammar, Hierarchy, float, float, Drawing] | None = None
     for factor in _factors(settings, symmetrizing, len(scene.elements)):
         check(cancel)
@@ -469,7 +377,7 @@ def rules_from_analysis(
         t = time.perf_counter()
         grammar = simplify(Grammar(inst.terminals, tuple(hier.rules), hier.axiom, scene.viewbox, scene.size))
         drawing = derive(grammar, limit=max(10 * len(scene.elements), 1000))
-        error = _deviation(inst, sizes, drawing, shape_dev, limit, measure)
+        error = deviation(inst, sizes, drawing, shape_dev, limit, measure)
         bits = grammar_bits(grammar, prec)
         stages["postprocess"] = stages.get("postprocess", 0.0) + time.perf_counter() - t
         # The first try is always kept; relaxed ones must stay within the tolerance and be shorter.

@@ -21,6 +21,7 @@ from lsys_core.hierarchy.candidates import (
     PairCandidate,
     SeqCandidate,
 )
+from lsys_core.hierarchy.describe import rule_bits, structured_bits, symbol_bits
 from lsys_core.hierarchy.emit import counters, rule_cases
 from lsys_core.hierarchy.flat import sorted_unique
 from lsys_core.hierarchy.mdl import (
@@ -29,9 +30,6 @@ from lsys_core.hierarchy.mdl import (
     count_bits,
     placement_set_bits,
     pose_bits,
-    rule_bits,
-    structured_bits,
-    symbol_bits,
     token_bits,
     transform_bits,
 )

@@ -17,7 +17,6 @@ groups of elements.  Each level:
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 from functools import partial
 
@@ -29,35 +28,20 @@ from lsys_core.hierarchy.analysis import find_candidates
 from lsys_core.hierarchy.cache import LevelCache
 from lsys_core.hierarchy.candidates import Candidate, SeqCandidate
 from lsys_core.hierarchy.emit import const_t, const_t_many, emit
-from lsys_core.hierarchy.gain import Ledger, placement_error
+from lsys_core.hierarchy.gain import Ledger
 from lsys_core.hierarchy.mdl import Precision
 from lsys_core.hierarchy.nodes import Nodes
-from lsys_core.hierarchy.snap import SHARE, plainer, snapped
+from lsys_core.hierarchy.select import Measure, Weights, choose, worthwhile
+from lsys_core.hierarchy.snap import SHARE
 from lsys_core.hierarchy.spaces import pair_space
 from lsys_core.hierarchy.symbols import SymbolTable
-from lsys_core.settings import setting
 
 __all__ = ["Hierarchy", "Tolerance", "Weights", "build_hierarchy"]
 
 #: Levels of the hierarchy at most (each level codes at least one repetition).
 MAX_LEVELS = 100
-#: ``measure(elements, a, b)``: how far input elements would be from their terminals drawn at poses ``a, b``.
-Measure = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 #: Default tolerance, as a share of the drawing's diagonal, when none is given.
 DEFAULT_TOLERANCE = 0.005
-#: A best candidate covering less than this share of the nodes is applied together with all
-#: other candidates on disjoint nodes (see :func:`_choose`).
-WEAK_COVER = 0.05
-
-
-@dataclass(frozen=True)
-class Weights:
-    """User weights of the cluster importance ``w = wn·n + wh·h + wφ·φ + wl·l``, each in [0, 1]."""
-
-    wn: float = setting("wn").default
-    wh: float = setting("wh").default
-    wphi: float = setting("wphi").default
-    wl: float = setting("wl").default
 
 
 @dataclass(frozen=True)
@@ -122,7 +106,7 @@ def build_hierarchy(
     center: np.ndarray,
     radius: np.ndarray,
     *,
-    weights: Weights = Weights(),
+    weights: Weights | None = None,
     tol: Tolerance = Tolerance(),
     similarity: np.ndarray | None = None,
     precision: Precision | None = None,
@@ -180,6 +164,7 @@ def build_hierarchy(
     -------
     Hierarchy
     """
+    weights = weights if weights is not None else Weights()
     nt = len(terminal_names)
     sim = similarity if similarity is not None else np.full((nt, nt), 0.5) + 0.5 * np.eye(nt)
     table = SymbolTable(terminal_names, terminal_sizes, sim)
@@ -224,7 +209,7 @@ def build_hierarchy(
             first = nodes.first_members()
             cands = [replace(c, start=_start(c, first)) for c in cands]
             test = partial(
-                _worthwhile,
+                worthwhile,
                 ledger=ledger,
                 nodes=nodes,
                 sizes=table.sizes,
@@ -234,7 +219,7 @@ def build_hierarchy(
                 n_terminals=nt,
                 limit=limit,
             )
-            chosen = _choose(cands, weights, len(nodes), test)
+            chosen = choose(cands, weights, len(nodes), test)
         if chosen:
             level += 1
             nodes = _apply_all(table, book, chosen, nodes)
@@ -303,124 +288,10 @@ def _duplicates(table: SymbolTable, nodes: Nodes) -> list[Candidate]:
     ]
 
 
-def _worthwhile(
-    c: Candidate,
-    ledger: Ledger,
-    nodes: Nodes,
-    sizes: np.ndarray,
-    period: np.ndarray,
-    snap: float,
-    measure: Measure | None = None,
-    n_terminals: int = 0,
-    limit: float = np.inf,
-) -> Candidate | None:
-    """The candidate with its numbers rounded, if it shortens the description within the tolerance.
-
-    This is the minimum description length test (:mod:`lsys_core.hierarchy.mdl`): a transform
-    that repeats by chance among unrelated elements does not pay for its rule.  Its numbers
-    are rounded first (:func:`~lsys_core.hierarchy.snap.snapped`), and the rule, derived from
-    each application's first node, must put every node within its slack (what is left of the
-    tolerance once its shapes and earlier rules have used their part).  Where that bound is
-    too coarse for single elements (hand-drawn copies: shape and pose noise add up on paper,
-    not on the page), ``measure`` tells how far the derived element really is.
-    """
-    c = snapped(c, nodes, limit, snap)
-    for variant in (plainer(c), c):  # a transform without its small turn and scale, if it fits
-        if variant is None:
-            continue
-        accepted = _admitted(variant, ledger, nodes, sizes, period, measure, n_terminals, limit)
-        if accepted is not None:
-            return accepted
-    return None
-
-
-def _admitted(
-    c: Candidate,
-    ledger: Ledger,
-    nodes: Nodes,
-    sizes: np.ndarray,
-    period: np.ndarray,
-    measure: Measure | None,
-    n_terminals: int,
-    limit: float,
-) -> Candidate | None:
-    """``c`` with its slack, starts and gain set, if it places its nodes within their slack and pays."""
-    idx, err, starts, (pa, pb) = placement_error(c, nodes, sizes, period)
-    left = nodes.slack[idx] - err
-    over = np.flatnonzero(left < 0.0)
-    if over.size and measure is not None:
-        single = np.array([nodes.members[i].size == 1 for i in idx[over]]) & (
-            nodes.sym[idx[over]] < n_terminals
-        )
-        if single.all():
-            elements = np.array([int(nodes.members[i][0]) for i in idx[over]])
-            left[over] = limit - measure(elements, pa[over], pb[over])
-    gain = ledger.gain(c) if not (left < 0.0).any() else 0.0
-    if gain <= 0.0:
-        return None
-    owner = np.repeat(np.arange(len(c.groups)), [g.size for g in c.groups])
-    slack = np.full(len(c.groups), np.inf)
-    np.minimum.at(slack, owner, left)
-    poses = () if starts is None else tuple(zip(starts[0].tolist(), starts[1].tolist(), strict=True))
-    return replace(c, slack=tuple(float(v) for v in slack), starts=poses, gain=gain)
-
-
 def _start(c: Candidate, first: np.ndarray) -> tuple[float, float]:
     """Mean input order of the first and of the second elements of a candidate's applications."""
     second = [first[g[1]] if g.size > 1 else first[g[0]] for g in c.groups]
     return float(np.mean([first[g[0]] for g in c.groups])), float(np.mean(second))
-
-
-def _scores(cands: list[Candidate], w: Weights) -> np.ndarray:
-    """The importance ``w = wn·n + wh·h + wφ·φ + wl·l`` of every candidate (§5.4, eq. 5)."""
-    cov = max(c.covered for c in cands)
-    lmax = max(c.l for c in cands)
-    return np.array(
-        [w.wn * c.covered / cov + w.wh * min(c.h, 1.0) + w.wphi * c.phi + w.wl * (c.l / lmax) for c in cands]
-    )
-
-
-def _choose(
-    cands: list[Candidate],
-    weights: Weights,
-    n_nodes: int,
-    worthwhile: Callable[[Candidate], Candidate | None],
-) -> list[Candidate]:
-    """The candidates to apply at this level, most important first (§5.4–§5.5).
-
-    Candidates are taken in order of importance; among equally important ones the one that
-    shortens the description most (then covers most, then comes first in the drawing: a
-    sequence read forwards or backwards) is applied.
-    When it covers only a small part of the scene (weak structure among clutter), every other
-    worthwhile candidate on disjoint nodes is applied in the same level, so the number of
-    levels stays small.  Only the candidates looked at are tested.
-    """
-    scores = np.round(_scores(cands, weights), 9)
-    order = sorted(
-        range(len(cands)),
-        key=lambda i: (scores[i], cands[i].covered, -cands[i].start[0], -cands[i].start[1]),
-        reverse=True,
-    )
-    taken = np.zeros(n_nodes, bool)
-    out: list[Candidate] = []
-    k = 0
-    while k < len(order):
-        # candidates of equal importance: the one that shortens the description most goes first
-        tied = [i for i in order[k:] if scores[i] == scores[order[k]]]
-        k += len(tied)
-        found = []
-        for i in tied:
-            if not taken[cands[i].nodes()].any() and (c := worthwhile(cands[i])) is not None:
-                found.append(c)
-        for c in sorted(found, key=lambda c: (c.gain, c.covered, -c.start[0], -c.start[1]), reverse=True):
-            nodes = c.nodes()
-            if taken[nodes].any():
-                continue
-            taken[nodes] = True
-            out.append(c)
-            if out[0].covered >= WEAK_COVER * n_nodes:
-                return out
-    return out
 
 
 def _apply_all(table: SymbolTable, book: _Book, chosen: list[Candidate], nodes: Nodes) -> Nodes:

@@ -24,9 +24,11 @@ from lsys_core.cancel import CancelToken, Progress, check, report
 from lsys_core.errors import InferenceError
 from lsys_core.grammar.model import Terminal
 from lsys_core.instancing.exact import EXACT_TOL, fit_exact, structure_key, variants
-from lsys_core.instancing.match import PERFECT, Batch, Reference, match_batch
+from lsys_core.instancing.match import PERFECT, match_batch
 from lsys_core.instancing.model import Instancing
+from lsys_core.instancing.reference import Batch, Reference
 from lsys_core.instancing.sampling import Samples, arc_fractions, element_features, sample_elements
+from lsys_core.instancing.symmetry import canonical, symmetry_order
 from lsys_core.parallel import pmap
 from lsys_core.svg.model import Element, Scene
 
@@ -69,80 +71,6 @@ def _style_key(style: str) -> str:
     fill, stroke, widths and opacity), so shapes that differ only in style are one terminal.
     """
     return ""
-
-
-def _rotate_residuals(probe, dense, normals, tree: cKDTree, angles: np.ndarray, tol: float) -> np.ndarray:
-    """Return, per angle, the largest distance of the rotated ``probe`` from the outline of ``dense``.
-
-    Distances are point-to-line at the nearest dense sample (and at least a tenth of the
-    point distance, so a probe that lands on nothing still counts); probes farther than
-    ``20 * tol`` from every sample count as infinitely far.
-    """
-    x = (probe[None, :] * np.exp(1j * np.asarray(angles))[:, None]).ravel()
-    dist, nn = tree.query(np.column_stack([x.real, x.imag]), distance_upper_bound=20 * tol)
-    nn = np.minimum(nn, dense.size - 1)
-    line = np.abs(((x - dense[nn]) * np.conj(normals[nn])).real)
-    return np.maximum(line, 0.1 * dist).reshape(len(angles), -1).max(axis=1)
-
-
-def symmetry_order(dense: np.ndarray, normals: np.ndarray, tol: float = 0.01) -> tuple[int, int]:
-    """Detect the rotational symmetry of a shape from dense samples about its centroid.
-
-    Every ``k`` up to 12 is tried by rotating a subset of the samples by ``360°/k`` and
-    measuring how far they land from the outline; higher orders (regular polygons with
-    many sides) are found from the angular moments ``mean(z**m)``, which vanish unless
-    ``k`` divides ``m``; a shape that matches itself at arbitrary angles is continuous.
-
-    Parameters
-    ----------
-    dense : ndarray of complex
-        Arc-length uniform samples, in order, centred on their mean and scaled to RMS radius 1.
-    normals : ndarray of complex
-        Unit normals at the samples.
-    tol : float
-        Largest deviation (in RMS radii) of the rotated shape from itself.
-
-    Returns
-    -------
-    tuple of int
-        ``(order, period)``: ``order`` is 1 (none), ``k`` (k-fold, k ≤ 12) or 0 (continuous,
-        or more than 12-fold); ``period`` is the ``k`` to reduce pose angles by (0: any angle).
-    """
-    tree = cKDTree(np.column_stack([dense.real, dense.imag]))
-    probe = dense[:: max(1, dense.size // 96)]
-    low = np.arange(12, 1, -1)
-    generic = np.array([0.7137, 2.0911, 3.3])
-    res = _rotate_residuals(probe, dense, normals, tree, np.concatenate([generic, 2 * np.pi / low]), tol)
-    if (res[:3] < tol).all():
-        return 0, 0
-    ms = np.arange(13, 65)
-    powers = np.empty((ms.size, dense.size), complex)
-    powers[0] = dense**13
-    powers[1:] = dense
-    with np.errstate(over="ignore", invalid="ignore"):
-        powers = np.cumprod(powers, axis=0)  # dense ** m for every m
-        num = np.abs(powers.mean(axis=1))
-        den = np.mean(np.abs(powers), axis=1)
-    strength = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
-    for k in ms[strength > 0.02][::-1]:  # candidate high orders, largest first
-        alone = (strength[ms % k != 0] < 0.02).all()
-        if alone and _rotate_residuals(probe, dense, normals, tree, np.array([2 * np.pi / k]), tol)[0] < tol:
-            return 0, int(k)
-    fitting = low[res[3:] < tol]
-    return (int(fitting[0]), int(fitting[0])) if fitting.size else (1, 1)
-
-
-def _canonical(a: np.ndarray, period: int) -> np.ndarray:
-    """Reduce pose rotations to the equivalent one of smallest angle under k-fold symmetry."""
-    if period == 1:
-        return a
-    if period == 0:
-        return np.abs(a).astype(complex)
-    step = 2 * np.pi / period
-    ang = np.angle(a)
-    red = ang - np.round(ang / step) * step
-    red = np.where(red <= -np.pi / period + 1e-12, red + step, red)
-    return np.abs(a) * np.exp(1j * red)
 
 
 def _sample_all(elements, fractions, cancel, progress=None) -> Samples:
@@ -385,7 +313,7 @@ def detect_similarity(
         order, period = symmetry_order(rep_g.ref.dense, rep_g.ref.dense_normals)
         symmetry[g] = order
         sel = group == g
-        a[sel] = _canonical(a[sel], period)
+        a[sel] = canonical(a[sel], period)
         a[r], b[r] = 1.0, origin
     report(progress, _STAGE, 1.0)
     return Instancing(group, a, b, tuple(terminals), symmetry, np.array(mirror_of, dtype=int))

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from lsys_core.grammar.model import Case, Grammar, Linear, Pop, Push, Rule, Symbol, Terminal, Turtle
-from lsys_core.hierarchy.mdl import Precision, count_bits, grammar_bits, log2_binom, placement_set_bits
+from lsys_core.hierarchy.describe import grammar_bits
+from lsys_core.hierarchy.mdl import Precision, count_bits, log2_binom, placement_set_bits
 from lsys_core.pipeline import DEFAULT_DEVIATION, infer
 
 from .scenes import LEAF, place, scene

@@ -4,7 +4,7 @@ A grammar of one of the kinds the inference knows — a sequence (turning, scali
 arc, a grid, a branching, rings of groups (nested), with a mirror image and with scale — is
 derived, inferred back and derived again: the two drawings agree within the tolerance, and
 the inferred grammar is no longer, in bits at the precision the tolerance implies
-(:func:`lsys_core.hierarchy.mdl.grammar_bits`), than the true one plus a small margin.
+(:func:`lsys_core.hierarchy.describe.grammar_bits`), than the true one plus a small margin.
 The examples are derandomised: the same cases run every time.
 """
 
@@ -15,7 +15,8 @@ from hypothesis import strategies as st
 
 from lsys_core.derive import derive
 from lsys_core.grammar import parse_grammar
-from lsys_core.hierarchy.mdl import Precision, grammar_bits
+from lsys_core.hierarchy.describe import grammar_bits
+from lsys_core.hierarchy.mdl import Precision
 from lsys_core.pipeline import DEFAULT_DEVIATION, infer
 from lsys_core.testing import assert_scenes_close, drawing_scene
 

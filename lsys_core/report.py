@@ -1,0 +1,111 @@
+"""How far a derived drawing is from the input it was inferred from (the numbers the report gives).
+
+Every input element is matched to the derived instance of its terminal nearest to its pose;
+its deviation is that of its shape (the terminal at its own pose) plus how far the pose
+moved, an upper bound of the outline distance, measured exactly
+(:mod:`lsys_core.instancing.deviation`) where the bound exceeds the tolerance.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from lsys_core.instancing.model import Instancing
+from lsys_core.svg.model import Scene
+
+__all__ = ["bounds", "deviation", "element_circles", "measurer", "reproduction_error"]
+
+
+def element_circles(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+    """Return the centre and radius of every element's control polygon (vectorised)."""
+    sizes = np.array([e.cubics.shape[0] for e in scene.elements])
+    pts = np.concatenate([e.cubics.reshape(-1) for e in scene.elements])
+    owner = np.repeat(np.arange(sizes.size), sizes * 4)
+    cnt = np.bincount(owner, minlength=sizes.size)
+    cen = (np.bincount(owner, pts.real, sizes.size) + 1j * np.bincount(owner, pts.imag, sizes.size)) / cnt
+    rad = np.zeros(sizes.size)
+    np.maximum.at(rad, owner, np.abs(pts - cen[owner]))
+    return cen, rad
+
+
+def bounds(scene: Scene) -> tuple[complex, complex]:
+    """Corners of the bounding box of all control points (it holds every outline)."""
+    pts = np.concatenate([e.cubics.reshape(-1) for e in scene.elements])
+    return complex(pts.real.min(), pts.imag.min()), complex(pts.real.max(), pts.imag.max())
+
+
+def _matched(inst: Instancing, sizes: np.ndarray, drawing) -> tuple[np.ndarray, np.ndarray] | None:
+    """The derived pose matched to every input element, or None when instances are missing.
+
+    Each input element is matched to the nearest derived instance of its terminal (by
+    position, and by rotation and scale at the shape's radius: copies turned about one point
+    share their position).
+    """
+    a_out = np.zeros_like(inst.a)
+    b_out = np.zeros_like(inst.b)
+    for g in range(len(inst.terminals)):
+        mine = np.flatnonzero(inst.group == g)
+        theirs = np.flatnonzero(drawing.symbol == g)
+        if mine.size != theirs.size:
+            return None
+        if mine.size == 0:
+            continue
+
+        def poses(a: np.ndarray, b: np.ndarray, size: float = float(sizes[g])) -> np.ndarray:
+            return np.column_stack([b.real, b.imag, size * a.real, size * a.imag])
+
+        ta, tb = drawing.a[theirs], drawing.b[theirs]
+        _, j = cKDTree(poses(ta, tb)).query(poses(inst.a[mine], inst.b[mine]))
+        a_out[mine], b_out[mine] = ta[j], tb[j]
+    return a_out, b_out
+
+
+def _displacements(inst: Instancing, sizes: np.ndarray, drawing) -> np.ndarray:
+    """How far every input element's pose moved in ``drawing`` (translation plus turn/scale at its reach)."""
+    matched = _matched(inst, sizes, drawing)
+    if matched is None:
+        return np.full(inst.a.size, np.inf)
+    a, b = matched
+    return np.abs(inst.b - b) + sizes[inst.group] * np.abs(inst.a - a)
+
+
+def reproduction_error(inst: Instancing, sizes: np.ndarray, drawing) -> float:
+    """Largest displacement of an input element's pose in ``drawing`` (document units; inf if one is missing)."""
+    d = _displacements(inst, sizes, drawing)
+    return float(d.max()) if d.size else 0.0
+
+
+def deviation(
+    inst: Instancing, sizes: np.ndarray, drawing, shape_dev: np.ndarray, limit: float, measure
+) -> float:
+    """Largest distance of a derived element from its input element (document units).
+
+    The shape's deviation plus its pose's displacement bounds it; where that bound exceeds
+    ``limit``, the derived outline is measured.
+    """
+    matched = _matched(inst, sizes, drawing)
+    if matched is None:
+        return float("inf")
+    a, b = matched
+    bound = shape_dev + np.abs(inst.b - b) + sizes[inst.group] * np.abs(inst.a - a)
+    over = np.flatnonzero(bound > limit)
+    if over.size:
+        bound[over] = measure(over, a[over], b[over])
+    return float(bound.max()) if bound.size else 0.0
+
+
+def measurer(scene: Scene, inst: Instancing) -> Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
+    """``measure(elements, a, b)``: the deviation of input elements from their terminals at poses ``a, b``."""
+    from lsys_core.geometry.shapes import shape_arrays
+    from lsys_core.instancing.deviation import pose_deviations
+    from lsys_core.svg.model import Element
+
+    shapes = [Element(*shape_arrays(t.path)) for t in inst.terminals]
+
+    def measure(elements: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return pose_deviations([scene.elements[i] for i in elements], shapes, inst.group[elements], a, b)
+
+    return measure
