@@ -134,9 +134,13 @@ def choose(
     out: list[Candidate] = []
     k = 0
     while k < len(order):
-        # candidates of equal importance: the one that shortens the description most goes first
-        tied = [i for i in order[k:] if score[i] == score[order[k]]]
-        k += len(tied)
+        # candidates of equal importance (consecutive in ``order``): the one that shortens the
+        # description most goes first
+        end = k + 1
+        while end < len(order) and score[order[end]] == score[order[k]]:
+            end += 1
+        tied = order[k:end]
+        k = end
         found = []
         for i in tied:
             if not taken[cands[i].nodes()].any() and (c := worthwhile(cands[i])) is not None:

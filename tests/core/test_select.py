@@ -1,0 +1,85 @@
+"""Which candidates a level applies (:func:`lsys_core.hierarchy.select.choose`).
+
+A reference written the plain way (every tie group found by scanning the whole rest of the
+ordered list) is checked against the linear grouping of equal scores, on random candidates
+with many ties, overlaps and rejections.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from lsys_core.hierarchy.candidates import Candidate, SeqCandidate
+from lsys_core.hierarchy.select import WEAK_COVER, Weights, choose, scores
+
+
+def _reference(
+    cands: list[Candidate],
+    weights: Weights,
+    n_nodes: int,
+    worthwhile: Callable[[Candidate], Candidate | None],
+) -> list[Candidate]:
+    """The candidate choice with each tie group found by a scan of the rest of the order."""
+    score = np.round(scores(cands, weights), 9)
+    order = sorted(
+        range(len(cands)),
+        key=lambda i: (score[i], cands[i].covered, -cands[i].start[0], -cands[i].start[1]),
+        reverse=True,
+    )
+    taken = np.zeros(n_nodes, bool)
+    out: list[Candidate] = []
+    k = 0
+    while k < len(order):
+        tied = [i for i in order[k:] if score[i] == score[order[k]]]
+        k += len(tied)
+        found = [
+            c for i in tied if not taken[cands[i].nodes()].any() and (c := worthwhile(cands[i])) is not None
+        ]
+        for c in sorted(found, key=lambda c: (c.gain, c.covered, -c.start[0], -c.start[1]), reverse=True):
+            if taken[c.nodes()].any():
+                continue
+            taken[c.nodes()] = True
+            out.append(c)
+            if out[0].covered >= WEAK_COVER * n_nodes:
+                return out
+    return out
+
+
+def _candidate(nodes: list[int], h: float, start: float, gain: float) -> SeqCandidate:
+    groups = tuple(np.array([n]) for n in nodes)
+    return SeqCandidate(
+        space=(0, 0), groups=groups, h=h, phi=1.0, l=1.0, A=1 + 0j, B=0j, start=(start, 0.0), gain=gain
+    )
+
+
+_CAND = st.tuples(
+    st.lists(st.integers(0, 199), min_size=2, max_size=4, unique=True),
+    st.sampled_from([0.25, 0.5, 1.0]),  # few distinct proximities: many equal importances
+    st.integers(0, 5),
+    st.sampled_from([-1.0, 1.0, 2.0, 3.0]),  # gain <= 0: not worthwhile
+)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(_CAND, min_size=1, max_size=40))
+def test_choose_matches_the_plain_tie_scan(raw):
+    cands = [_candidate(nodes, h, start, gain) for nodes, h, start, gain in raw]
+
+    def worthwhile(c: Candidate) -> Candidate | None:
+        return c if c.gain > 0 else None
+
+    got = choose(cands, Weights(), 200, worthwhile)
+    want = _reference(cands, Weights(), 200, worthwhile)
+    assert [id(c) for c in got] == [id(c) for c in want]
+
+
+def test_equal_importance_goes_by_bits_saved():
+    small = _candidate([0, 1], 1.0, 0, gain=1.0)
+    large = _candidate([1, 2], 1.0, 1, gain=5.0)  # same importance, overlaps ``small``, saves more
+    other = _candidate([3, 4], 0.25, 2, gain=9.0)  # less important, disjoint
+    got = choose([small, large, other], Weights(), 1000, lambda c: c)
+    assert got == [large, other]
