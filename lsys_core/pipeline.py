@@ -8,7 +8,7 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -29,9 +29,8 @@ from lsys_core.hierarchy.snap import SHARE
 from lsys_core.instancing.fidelity import split_unfaithful
 from lsys_core.instancing.model import Instancing
 from lsys_core.instancing.orientation import unwrap_symmetric
-from lsys_core.report import bounds, deviation, element_circles, measurer, reproduction_error
-from lsys_core.settings import SETTINGS, setting
-from lsys_core.settings import check as check_setting
+from lsys_core.report import InferenceResult, bounds, deviation, element_circles, measurer, reproduction_error
+from lsys_core.settings import RELAXED, InferenceSettings
 from lsys_core.svg.model import Scene
 
 __all__ = [
@@ -44,8 +43,6 @@ __all__ = [
     "symmetrize",
 ]
 
-#: Bandwidth factor used by :func:`symmetrize` (the paper's "relaxed sensitivity").
-RELAXED = 12.0
 #: Default tolerance: the derived drawing may deviate from the input by this share of its diagonal.
 DEFAULT_DEVIATION = 0.005
 #: With tolerance 0 (exact copies only), rules still place elements to this share of the
@@ -60,95 +57,6 @@ LARGE_SCENE = 1000
 #: The tolerance of :func:`symmetrize`, whose purpose is to move elements onto a regular pattern
 #: (share of the diagonal; the user's tolerance if larger).
 SYMMETRIZE_ERROR = 0.03
-
-
-@dataclass(frozen=True)
-class InferenceSettings:
-    """User settings of the inference.
-
-    Attributes
-    ----------
-    wn, wh, wphi, wl : float
-        Cluster importance weights in [0, 1] (§5.4): repetition count, proximity,
-        similarity and sequence length.
-    similarity : float
-        Similarity threshold φ for two elements to share a terminal (§4.1).
-    tolerance : float
-        Factor on the clustering bandwidths; larger values merge jittered repetitions.
-    neighbours : int
-        Neighbours per node in the transformation spaces.
-    deviation : float or None
-        The tolerance: how far (document units) the derived drawing may deviate from the
-        input, shapes and placements together.  Near-identical shapes within it share a
-        terminal, and rules must place their elements within it.  None: 0.5 % of the
-        drawing's diagonal (:data:`DEFAULT_DEVIATION`); 0: exact copies only.
-    """
-
-    wn: float = setting("wn").default
-    wh: float = setting("wh").default
-    wphi: float = setting("wphi").default
-    wl: float = setting("wl").default
-    similarity: float = setting("similarity").default
-    tolerance: float = setting("tolerance").default
-    neighbours: int = 24
-    deviation: float | None = None
-
-    def relaxed(self, factor: float = RELAXED) -> InferenceSettings:
-        """Return these settings with the tolerance multiplied by ``factor`` (for symmetrization)."""
-        return replace(self, tolerance=self.tolerance * factor)
-
-    def validated(self) -> InferenceSettings:
-        """Return the settings, raising :class:`InferenceError` for values out of range.
-
-        The ranges are those of :data:`lsys_core.settings.SETTINGS` (which the editor's sliders
-        and the CLI's help show too).
-        """
-        for s in SETTINGS:
-            problem = check_setting(s.name, float(getattr(self, s.name)))
-            if problem is not None:
-                raise InferenceError(problem)
-        if self.deviation is not None and not (0.0 <= self.deviation < np.inf):
-            raise InferenceError(f"deviation must be a length >= 0, got {self.deviation:g}")
-        return self
-
-
-@dataclass(frozen=True, eq=False)
-class InferenceResult:
-    """What :func:`infer` returns: the grammar, the instancing, timings and how good the rules are.
-
-    Attributes
-    ----------
-    grammar : Grammar
-        The inferred rules.
-    instancing : Instancing
-        Terminals and poses of the input elements (with each element's shape deviation).
-    stages : dict of str to float
-        Seconds per stage (and ``reproduction_error``, the placement error over the diagonal).
-    seconds : float
-        Total time.
-    log : tuple of str
-        One line per rule written.
-    tolerance : float
-        The tolerance used (document units).
-    max_deviation : float
-        Largest distance of a derived element from its input element (document units): its
-        shape's deviation plus the displacement of its pose, an upper bound.
-    explained : float
-        Share of the elements placed by repetition rules, not one by one.
-    description_bits : tuple of float
-        Description length before (every element its own shape, placed one by one) and
-        after (the grammar), in bits at the precision the tolerance implies.
-    """
-
-    grammar: Grammar
-    instancing: Instancing
-    stages: dict[str, float]
-    seconds: float
-    log: tuple[str, ...] = field(default=())
-    tolerance: float = 0.0
-    max_deviation: float = 0.0
-    explained: float = 0.0
-    description_bits: tuple[float, float] = (0.0, 0.0)
 
 
 def _shape_similarity(inst: Instancing, cancel: CancelToken | None) -> np.ndarray:

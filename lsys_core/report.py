@@ -1,4 +1,6 @@
-"""How far a derived drawing is from the input it was inferred from (the numbers the report gives).
+"""What the inference reports: its result, and how far the derived drawing is from the input.
+
+:class:`InferenceResult` is what :func:`~lsys_core.pipeline.infer` returns.
 
 Every input element is matched to the derived instance of its terminal nearest to its pose;
 its deviation is that of its shape (the terminal at its own pose) plus how far the pose
@@ -9,14 +11,16 @@ moved, an upper bound of the outline distance, measured exactly
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.spatial import cKDTree
 
+from lsys_core.grammar.model import Grammar
 from lsys_core.instancing.model import Instancing
 from lsys_core.svg.model import Scene
 
-__all__ = ["bounds", "deviation", "element_circles", "measurer", "reproduction_error"]
+__all__ = ["InferenceResult", "bounds", "deviation", "element_circles", "measurer", "reproduction_error"]
 
 
 def element_circles(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
@@ -109,3 +113,42 @@ def measurer(scene: Scene, inst: Instancing) -> Callable[[np.ndarray, np.ndarray
         return pose_deviations([scene.elements[i] for i in elements], shapes, inst.group[elements], a, b)
 
     return measure
+
+
+@dataclass(frozen=True, eq=False)
+class InferenceResult:
+    """What :func:`~lsys_core.pipeline.infer` returns: the grammar, the instancing, timings and how good the rules are.
+
+    Attributes
+    ----------
+    grammar : Grammar
+        The inferred rules.
+    instancing : Instancing
+        Terminals and poses of the input elements (with each element's shape deviation).
+    stages : dict of str to float
+        Seconds per stage (and ``reproduction_error``, the placement error over the diagonal).
+    seconds : float
+        Total time.
+    log : tuple of str
+        One line per rule written.
+    tolerance : float
+        The tolerance used (document units).
+    max_deviation : float
+        Largest distance of a derived element from its input element (document units): its
+        shape's deviation plus the displacement of its pose, an upper bound.
+    explained : float
+        Share of the elements placed by repetition rules, not one by one.
+    description_bits : tuple of float
+        Description length before (every element its own shape, placed one by one) and
+        after (the grammar), in bits at the precision the tolerance implies.
+    """
+
+    grammar: Grammar
+    instancing: Instancing
+    stages: dict[str, float]
+    seconds: float
+    log: tuple[str, ...] = field(default=())
+    tolerance: float = 0.0
+    max_deviation: float = 0.0
+    explained: float = 0.0
+    description_bits: tuple[float, float] = (0.0, 0.0)

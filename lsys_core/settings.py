@@ -1,17 +1,23 @@
 """The user settings of the inference: one definition of each, read by the pipeline, CLI and editor.
 
-Each :class:`Setting` names a field of :class:`~lsys_core.pipeline.InferenceSettings` with its
-default, its valid range and the words a user interface shows for it.  The range is the one
-the pipeline validates (:func:`check`), so a slider built over it never offers a value the
-pipeline refuses.  The module imports nothing, so a user interface can read it at once.
+Each :class:`Setting` names a field of :class:`InferenceSettings` with its default, its valid
+range and the words a user interface shows for it.  The range is the one
+:meth:`InferenceSettings.validated` checks (:func:`check`), so a slider built over it never
+offers a value the pipeline refuses.  The module imports nothing heavy (no numpy), so a user
+interface can read it at once.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
-__all__ = ["SETTINGS", "Setting", "check", "setting"]
+from lsys_core.errors import InferenceError
+
+__all__ = ["RELAXED", "SETTINGS", "InferenceSettings", "Setting", "check", "setting"]
+
+#: Bandwidth factor used by :func:`~lsys_core.pipeline.symmetrize` (the paper's "relaxed sensitivity").
+RELAXED = 12.0
 
 
 @dataclass(frozen=True)
@@ -108,3 +114,53 @@ def check(name: str, value: float) -> str | None:
 def _short(x: float) -> str:
     """Return ``x`` in few characters: ``1``, ``0.6``, ``1e-6``."""
     return f"{x:g}".replace("e-0", "e-").replace("e+0", "e+")
+
+
+@dataclass(frozen=True)
+class InferenceSettings:
+    """User settings of the inference.
+
+    Attributes
+    ----------
+    wn, wh, wphi, wl : float
+        Cluster importance weights in [0, 1] (§5.4): repetition count, proximity,
+        similarity and sequence length.
+    similarity : float
+        Similarity threshold φ for two elements to share a terminal (§4.1).
+    tolerance : float
+        Factor on the clustering bandwidths; larger values merge jittered repetitions.
+    neighbours : int
+        Neighbours per node in the transformation spaces.
+    deviation : float or None
+        The tolerance: how far (document units) the derived drawing may deviate from the
+        input, shapes and placements together.  Near-identical shapes within it share a
+        terminal, and rules must place their elements within it.  None: 0.5 % of the
+        drawing's diagonal (:data:`lsys_core.pipeline.DEFAULT_DEVIATION`); 0: exact copies only.
+    """
+
+    wn: float = setting("wn").default
+    wh: float = setting("wh").default
+    wphi: float = setting("wphi").default
+    wl: float = setting("wl").default
+    similarity: float = setting("similarity").default
+    tolerance: float = setting("tolerance").default
+    neighbours: int = 24
+    deviation: float | None = None
+
+    def relaxed(self, factor: float = RELAXED) -> InferenceSettings:
+        """Return these settings with the tolerance multiplied by ``factor`` (for symmetrization)."""
+        return replace(self, tolerance=self.tolerance * factor)
+
+    def validated(self) -> InferenceSettings:
+        """Return the settings, raising :class:`InferenceError` for values out of range.
+
+        The ranges are those of :data:`SETTINGS` (which the editor's sliders
+        and the CLI's help show too).
+        """
+        for s in SETTINGS:
+            problem = check(s.name, float(getattr(self, s.name)))
+            if problem is not None:
+                raise InferenceError(problem)
+        if self.deviation is not None and not (0.0 <= self.deviation < math.inf):
+            raise InferenceError(f"deviation must be a length >= 0, got {self.deviation:g}")
+        return self
