@@ -10,197 +10,30 @@ arrives); full anti-aliased quality follows as soon as the interaction stops.
 
 Also: pan (drag, space-drag, middle button), zoom at the cursor (wheel), fit / 100 %, an
 optional overlay of the input SVG, colouring by similarity group or by rule, and picking the
-element under a click.
+element under a click.  The frame itself is made in :mod:`app.frames`, the colouring in
+:mod:`app.coloring`.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, QSize, Qt, QTimer, Signal
-from PySide6.QtGui import QColor, QImage, QPainter, QTransform
+from PySide6.QtGui import QColor, QPainter, QTransform
 from PySide6.QtWidgets import QSizePolicy, QWidget
 
 from . import core
+from .coloring import group_color, legend, recolor, rule_color
+from .frames import Frame, RenderRequest, View, render_frame
 from .workers import LatestRunner
 
 __all__ = ["Canvas", "Frame", "RenderRequest", "View", "group_color", "legend", "recolor", "rule_color"]
 
 SETTLE_MS = 120  # quiet time after pan/zoom before rendering at full quality
-BACKGROUND = (255, 255, 255, 255)
-#: Pixel format of ``Renderer.draw``'s array: RGBA bytes, premultiplied alpha (as skia draws).
-RENDER_FORMAT = QImage.Format.Format_RGBA8888_Premultiplied
 MIN_ZOOM, MAX_ZOOM = 1e-4, 1e4
-#: Colours cycled for the colour-by-group / colour-by-rule modes.
-PALETTE = (
-    "#1f77b4",
-    "#ff7f0e",
-    "#2ca02c",
-    "#d62728",
-    "#9467bd",
-    "#8c564b",
-    "#e377c2",
-    "#7f7f7f",
-    "#bcbd22",
-    "#17becf",
-    "#393b79",
-    "#e7ba52",
-    "#637939",
-    "#ad494a",
-    "#7b4173",
-    "#3182bd",
-)
-
-
-@dataclass(frozen=True)
-class View:
-    """How document coordinates map to the widget: ``widget = doc * zoom + (ox, oy)`` (logical pixels)."""
-
-    zoom: float = 1.0
-    ox: float = 0.0
-    oy: float = 0.0
-
-    def to_widget(self, x: float, y: float) -> tuple[float, float]:
-        """Map a document point to widget (logical pixel) coordinates."""
-        return x * self.zoom + self.ox, y * self.zoom + self.oy
-
-    def to_doc(self, x: float, y: float) -> tuple[float, float]:
-        """Map a widget point to document coordinates."""
-        return (x - self.ox) / self.zoom, (y - self.oy) / self.zoom
-
-    def transform(self) -> QTransform:
-        """Return the document → widget transform."""
-        return QTransform(self.zoom, 0, 0, self.zoom, self.ox, self.oy)
-
-
-@dataclass(frozen=True)
-class RenderRequest:
-    """One frame to render: immutable inputs, plus the surface to draw into (set when it starts)."""
-
-    drawing: Any
-    color_mode: str
-    view: View
-    width: int
-    height: int
-    dpr: float
-    draft: bool
-    highlight: Any = None  # bool mask of instances drawn in the highlight colour
-    overlay: Any = None  # a QSvgRenderer of the input, painted translucently on top
-    overlay_rect: QRectF | None = None
-    renderer: Any = None
-    slot: int = 0
-
-
-@dataclass(frozen=True)
-class Frame:
-    """A rendered frame: the QImage, the array it wraps (kept alive with it), and its inputs."""
-
-    image: QImage
-    pixels: np.ndarray
-    renderer: Any
-    slot: int
-    drawing: Any
-    color_mode: str
-    view: View
-    size: tuple[int, int]
-    dpr: float
-    draft: bool
-    overlay: bool
-    seconds: float
-
-
-def render_frame(req: RenderRequest, cancel, progress) -> Frame:
-    """Render ``req`` on a worker: skia draws into the request's surface, wrapped zero-copy."""
-    t0 = time.perf_counter()
-    s = req.dpr
-    z = req.view.zoom
-    region = (-req.view.ox / z, -req.view.oy / z, req.width / (z * s), req.height / (z * s))
-    shown = recolor(req.drawing, req.color_mode)  # a copy with other styles: off the UI thread
-    pixels = req.renderer.draw(
-        shown, region, not req.draft, req.draft, background=BACKGROUND, highlight=req.highlight
-    )
-    cancel.check()
-    h, w = pixels.shape[:2]
-    image = QImage(pixels.data, w, h, pixels.strides[0], RENDER_FORMAT)
-    image.setDevicePixelRatio(s)
-    if req.overlay is not None and req.overlay_rect is not None:
-        painter = QPainter(image)
-        painter.setRenderHint(QPainter.RenderHint.Antialiasing, not req.draft)
-        painter.setTransform(req.view.transform())
-        painter.setOpacity(0.35)
-        req.overlay.render(painter, req.overlay_rect)
-        painter.end()
-    return Frame(
-        image,
-        pixels,
-        req.renderer,
-        req.slot,
-        req.drawing,
-        req.color_mode,
-        req.view,
-        (req.width, req.height),
-        s,
-        req.draft,
-        req.overlay is not None,
-        time.perf_counter() - t0,
-    )
-
-
-def _style_with_color(style: str, color: str) -> str:
-    """Return CSS declarations with fill and stroke (where painted) set to ``color``."""
-    decls = {}
-    for part in style.split(";"):
-        if ":" in part:
-            k, v = part.split(":", 1)
-            decls[k.strip()] = v.strip()
-    if decls.get("fill", "black") != "none":
-        decls["fill"] = color
-    if decls.get("stroke", "none") != "none":
-        decls["stroke"] = color
-    return ";".join(f"{k}:{v}" for k, v in decls.items())
-
-
-def group_color(terminal: int) -> str:
-    """Return the colour of terminal index ``terminal`` (a similarity group) in colour-by-group mode."""
-    return PALETTE[terminal % len(PALETTE)]
-
-
-def rule_color(rule: int) -> str:
-    """Return the colour of rule index ``rule`` (-1: the axiom) in colour-by-rule mode."""
-    return PALETTE[(rule + 1) % len(PALETTE)]
-
-
-def legend(grammar: Any, mode: str) -> list[tuple[str, str]]:
-    """Return ``(colour, what)`` for every colour the canvas uses in ``mode`` (none: empty)."""
-    if grammar is None or mode == "none":
-        return []
-    if mode == "group":
-        return [(group_color(i), f"terminal {t.name}") for i, t in enumerate(grammar.terminals)]
-    return [(rule_color(-1), "Start (axiom)")] + [
-        (rule_color(i), r.name) for i, r in enumerate(grammar.rules)
-    ]
-
-
-def recolor(drawing: Any, mode: str) -> Any:
-    """Return ``drawing`` with its instances' styles coloured by similarity group or by rule.
-
-    ``mode`` is ``"none"`` (unchanged), ``"group"`` (one colour per terminal symbol, i.e. per
-    similarity group) or ``"rule"`` (one colour per rule that emitted the instance).  Each
-    instance keeps its own style (opacity, stroke width, …) with fill and stroke recoloured.
-    """
-    if mode == "none" or drawing is None or len(drawing) == 0:
-        return drawing
-    styles, style = drawing.instance_styles()
-    key = np.asarray(drawing.symbol if mode == "group" else drawing.rule, np.int64)
-    color = group_color if mode == "group" else rule_color
-    pairs, inverse = np.unique(np.stack([style, key], axis=1), axis=0, return_inverse=True)
-    styled = tuple(_style_with_color(styles[s], color(k)) for s, k in pairs.tolist())
-    return dataclasses.replace(drawing, styles=styled, style=inverse.reshape(-1).astype(np.int32))
 
 
 class Canvas(QWidget):

@@ -23,7 +23,8 @@ from lsys_core.errors import LsysError
 
 from . import core
 from .actions import create_actions, create_menus, redo_keys, undo_keys
-from .canvas import Canvas, legend
+from .canvas import Canvas
+from .coloring import legend
 from .dialogs import RandomizeDialog, ReplaceDialog
 from .document import Document
 from .handles import HandleEditor, HandleOverlay

@@ -264,7 +264,7 @@ def test_zoom_pan_fit_and_100_percent(window, helix_lsys, qtbot, wait_idle):
 
 
 def test_color_modes_and_overlay(window, helix_lsys, wait_idle):
-    from app.canvas import recolor
+    from app.coloring import recolor
 
     _open(window, helix_lsys, wait_idle)
     window.doc.edit_text(window.doc.text.replace("axiom: P(119)", "axiom: A f(30) P(119)"))
