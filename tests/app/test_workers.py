@@ -149,7 +149,7 @@ def _stubborn(request, cancel, progress):
 
 
 def test_process_that_ignores_cancel_is_killed_and_start_never_blocks(qtbot):
-    from app import workers
+    from app import worker_process as workers
 
     compute = ProcessCompute(_stubborn)
     try:
