@@ -56,8 +56,9 @@ from lsys_core.render.paths import (
     _skia_paint,
     parse_style,
 )
+from lsys_core.render.sizing import default_view, fit_view, png_size
 from lsys_core.render.skia_import import load_skia
-from lsys_core.render.units import CSS_DPI, length_px
+from lsys_core.render.units import CSS_DPI
 
 __all__ = [
     "DRAFT_CHUNK",
@@ -67,6 +68,7 @@ __all__ = [
     "HIGHLIGHT",
     "MAX_PNG_PIXELS",
     "Renderer",
+    "default_view",
     "encode_png",
     "fit_view",
     "parse_style",
@@ -80,31 +82,6 @@ CACHE_SIZE = 4096
 MAX_SIDE = 16384
 #: Most pixels of a PNG written by :func:`render_png` (larger sizes are scaled down, aspect kept).
 MAX_PNG_PIXELS = 40_000_000
-
-
-def fit_view(view: tuple[float, float, float, float], width: int, height: int) -> tuple[float, float, float]:
-    """Return ``(scale, tx, ty)`` mapping ``view`` (x, y, w, h) centred into a width×height image."""
-    x, y, w, h = (float(v) for v in view)
-    w = w if w > 0 and math.isfinite(w) else 1.0
-    h = h if h > 0 and math.isfinite(h) else 1.0
-    s = min(width / w, height / h)
-    tx = (width - s * w) / 2.0 - s * x
-    ty = (height - s * h) / 2.0 - s * y
-    return s, tx, ty
-
-
-def default_view(drawing: Drawing) -> tuple[float, float, float, float]:
-    """Return the drawing's viewBox, or its bounds with a small margin, or a unit square."""
-    if drawing.viewbox is not None:
-        return drawing.viewbox
-    from lsys_core.render.svg import MARGIN, drawing_bounds
-
-    bounds = drawing_bounds(drawing)
-    if bounds is None:
-        return (0.0, 0.0, 1.0, 1.0)
-    x0, y0, x1, y1 = bounds
-    m = MARGIN * max(x1 - x0, y1 - y0) or 1.0
-    return (x0 - m, y0 - m, x1 - x0 + 2 * m, y1 - y0 + 2 * m)
 
 
 class Renderer:
@@ -349,44 +326,6 @@ def render(
     return _unpremultiply(pixels)
 
 
-def _png_size(
-    drawing: Drawing, width: int | None, height: int | None, dpi: float = CSS_DPI
-) -> tuple[int, int]:
-    """Choose the PNG size: as given, else the document's size in its units at ``dpi``, aspect kept.
-
-    Without ``width`` and ``height`` the size is the drawing's ``width``/``height`` converted
-    from their units (``cm``, ``in``, ``pt``, … at 96 CSS px per inch) to pixels at ``dpi``;
-    a missing or relative (``%``) size falls back to the viewBox size in user units.
-    """
-    _, _, vw, vh = default_view(drawing)
-    aspect = vw / vh if vw > 0 and vh > 0 else 1.0
-    if width is not None and height is not None:
-        w, h = int(width), int(height)
-    elif height is not None:
-        h = int(height)
-        w = max(1, round(h * aspect))
-    elif width is not None:
-        w = int(width)
-        h = max(1, round(w / aspect))
-    else:
-        size = drawing.size
-        given_w = length_px(size[0]) if size else None
-        given_h = length_px(size[1]) if size else None
-        if given_w is not None:
-            fw, fh = given_w, given_h if given_h is not None else given_w / aspect
-        elif given_h is not None:
-            fw, fh = given_h * aspect, given_h
-        else:
-            fw, fh = vw, vh
-        scale = dpi / CSS_DPI
-        w, h = max(1, round(fw * scale)), max(1, round(fh * scale))
-    w, h = min(w, MAX_SIDE), min(h, MAX_SIDE)
-    if w * h > MAX_PNG_PIXELS:
-        shrink = math.sqrt(MAX_PNG_PIXELS / (w * h))
-        w, h = max(1, int(w * shrink)), max(1, int(h * shrink))
-    return w, h
-
-
 def encode_png(
     drawing: Drawing,
     width: int | None = None,
@@ -412,7 +351,7 @@ def encode_png(
     skia = load_skia()
     if not (math.isfinite(dpi) and dpi > 0):
         raise LsysError(f"the resolution must be a positive number of dots per inch, got {dpi}")
-    w, h = _png_size(drawing, width, height, dpi)
+    w, h = png_size(drawing, width, height, dpi, MAX_SIDE, MAX_PNG_PIXELS)
     renderer = Renderer(w, h)
     renderer.draw(drawing, None, True, False, background=background)
     image = renderer._surface.makeImageSnapshot()
