@@ -26,6 +26,7 @@ from PySide6.QtGui import QColor, QPainter, QTransform
 from PySide6.QtWidgets import QSizePolicy, QWidget
 
 from . import core
+from .canvas_navigation import CanvasNavigation
 from .coloring import group_color, legend, recolor, rule_color
 from .frames import Frame, RenderRequest, View, render_frame
 from .workers import LatestRunner
@@ -33,10 +34,9 @@ from .workers import LatestRunner
 __all__ = ["Canvas", "Frame", "RenderRequest", "View", "group_color", "legend", "recolor", "rule_color"]
 
 SETTLE_MS = 120  # quiet time after pan/zoom before rendering at full quality
-MIN_ZOOM, MAX_ZOOM = 1e-4, 1e4
 
 
-class Canvas(QWidget):
+class Canvas(CanvasNavigation, QWidget):
     """The central view of the derived drawing.
 
     Signals
@@ -168,44 +168,6 @@ class Canvas(QWidget):
             if renderer.isValid():
                 self._overlay = renderer
                 self._overlay_rect = QRectF(renderer.viewBoxF())
-
-    def fit(self, render: bool = True) -> None:
-        """Fit the drawing (or its canvas viewbox) into the widget."""
-        bounds = self._bounds()
-        if bounds is None:
-            return
-        x0, y0, x1, y1 = bounds
-        w, h = max(self.width(), 1), max(self.height(), 1)
-        bw, bh = max(x1 - x0, 1e-9), max(y1 - y0, 1e-9)
-        zoom = min(max(min((w - 40) / bw, (h - 40) / bh), MIN_ZOOM), MAX_ZOOM)
-        cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
-        self.view = View(zoom, w / 2 - cx * zoom, h / 2 - cy * zoom)
-        self._user_moved = False
-        if render:
-            self.request_render()
-
-    def zoom_100(self) -> None:
-        """Show the drawing at 100 % (one SVG unit per logical pixel), keeping the centre."""
-        self.zoom_at(1.0 / self.view.zoom, QPointF(self.width() / 2, self.height() / 2))
-
-    def zoom_by(self, factor: float) -> None:
-        """Zoom around the widget centre."""
-        self.zoom_at(factor, QPointF(self.width() / 2, self.height() / 2))
-
-    def zoom_at(self, factor: float, pos: QPointF) -> None:
-        """Zoom by ``factor`` keeping the document point under ``pos`` fixed."""
-        v = self.view
-        zoom = min(max(v.zoom * factor, MIN_ZOOM), MAX_ZOOM)
-        f = zoom / v.zoom
-        self.view = View(zoom, pos.x() - (pos.x() - v.ox) * f, pos.y() - (pos.y() - v.oy) * f)
-        self._user_moved = True
-        self._interact()
-
-    def pan_by(self, dx: float, dy: float) -> None:
-        """Move the view by ``(dx, dy)`` logical pixels."""
-        self.view = View(self.view.zoom, self.view.ox + dx, self.view.oy + dy)
-        self._user_moved = True
-        self._interact()
 
     def is_idle(self) -> bool:
         """Whether the frame on screen is the final one for the current drawing and view."""
@@ -347,13 +309,6 @@ class Canvas(QWidget):
             self.request_render()
         return super().event(event)
 
-    def wheelEvent(self, event) -> None:
-        """Zoom at the cursor."""
-        steps = event.angleDelta().y() / 120.0
-        if steps:
-            self.zoom_at(1.2**steps, event.position())
-        event.accept()
-
     def keyPressEvent(self, event) -> None:
         """Space held: drag pans."""
         if event.key() == Qt.Key.Key_Space and not event.isAutoRepeat():
@@ -413,13 +368,3 @@ class Canvas(QWidget):
         self._drag_start = self._drag_view = self._press_pos = None
         if not self._space:
             self.unsetCursor()
-
-    def _bounds(self) -> tuple[float, float, float, float] | None:
-        d = self.drawing
-        if d is None:
-            return None
-        bounds = core.drawing_bounds(d) if len(d) else None
-        if bounds is None and d.viewbox is not None:
-            x, y, w, h = d.viewbox
-            return x, y, x + w, y + h
-        return bounds
