@@ -8,12 +8,13 @@ description (:mod:`lsys_core.hierarchy.gain`, minimum description length).
 
 from __future__ import annotations
 
+import cmath
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
 
-from lsys_core.hierarchy.candidates import Candidate
+from lsys_core.hierarchy.candidates import BranchCandidate, Candidate, PairCandidate, SeqCandidate
 from lsys_core.hierarchy.gain import Ledger, placement_error
 from lsys_core.hierarchy.nodes import Nodes
 from lsys_core.hierarchy.snap import plainer, snapped
@@ -38,6 +39,17 @@ class Weights:
     wl: float = setting("wl").default
 
 
+def _invertible(c: Candidate) -> bool:
+    """Whether every transform of ``c`` is finite with a non-zero scale."""
+    if isinstance(c, (SeqCandidate, PairCandidate)):
+        transforms = [(c.A, c.B)]
+    elif isinstance(c, BranchCandidate):
+        transforms = [c.first, c.second]
+    else:
+        transforms = []
+    return all(cmath.isfinite(a) and cmath.isfinite(b) and abs(a) > 0.0 for a, b in transforms)
+
+
 def worthwhile(
     c: Candidate,
     ledger: Ledger,
@@ -60,6 +72,8 @@ def worthwhile(
     not on the page), ``measure`` tells how far the derived element really is.
     """
     c = snapped(c, nodes, limit, snap)
+    if not _invertible(c):
+        return None  # a transform that collapses its copies to a point places nothing
     for variant in (plainer(c), c):  # a transform without its small turn and scale, if it fits
         if variant is None:
             continue

@@ -93,6 +93,8 @@ def plainer(c: Candidate) -> Candidate | None:
     """
     if not isinstance(c, (SeqCandidate, PairCandidate)) or abs(c.A - 1.0) < 1e-12:
         return None
+    if not (0.0 < abs(c.A) < math.inf):
+        return None  # a degenerate (collapsing or non-finite) transform has no plain step to try
     turn = math.degrees(float(np.angle(c.A)))
     if abs(turn) > PLAIN_TURN or abs(math.log(abs(c.A))) > PLAIN_SCALE:
         return None

@@ -70,3 +70,20 @@ def test_decimals_for_a_precision():
         and decimals_for(46.0, 0.01) == 0
         and decimals_for(0.125, 1e-4) == 3
     )
+
+
+def test_plainer_leaves_a_collapsing_transform_alone():
+    """A cluster whose transform scales to nothing (seen in a real flag) has no plain step."""
+    import numpy as np
+
+    from lsys_core.hierarchy.candidates import PairCandidate, SeqCandidate
+    from lsys_core.hierarchy.snap import plainer
+
+    groups = (np.array([0, 1]), np.array([2, 3]))
+    for kind in (SeqCandidate, PairCandidate):
+        for a in (0j, complex("nan"), complex("inf")):
+            assert plainer(kind(space=(0, 0), groups=groups, h=1.0, phi=1.0, l=0.5, A=a, B=1 + 0j)) is None
+        step = plainer(
+            kind(space=(0, 0), groups=groups, h=1.0, phi=1.0, l=0.5, A=complex(0.9999, 0.001), B=1 + 0j)
+        )
+        assert step is not None and step.A == 1.0
