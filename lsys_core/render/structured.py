@@ -4,7 +4,10 @@ A designer who opens the file sees what repeats:
 
 - every terminal is written once, in ``<defs>``, with its name as ``id`` (``A``, ``leaf``);
   a terminal that is a circle, an ellipse, a rectangle or a line is written as that element
-  (:func:`~lsys_core.render.primitives.primitive`);
+  (:func:`~lsys_core.render.primitives.primitive`) when no instance turns it; a turned one is
+  written as a ``<path>``, because a widely used reader (svgelements 1.9) drops the rotation
+  of a ``<use>`` when it turns a ``<rect>``, ``<circle>`` or ``<ellipse>`` into points (the
+  rendered pixels agree, its geometry does not);
 - every instance is a ``<use xlink:href="#A" transform="…">`` (a clone in Inkscape: edit the
   shape once, every copy follows), with ``translate``/``rotate``/``scale`` written only where
   they are not the identity.  ``xlink:href`` rather than SVG 2's plain ``href``: Inkscape 1.2
@@ -197,7 +200,10 @@ def _uses(drawing, symbol, style, styles, scale, plain, ids: _Ids) -> tuple[_Use
             common = {k: v for k, v in common.items() if k not in _LENGTH_KEYS}
         term = drawing.terminals[t]
         ref = ids.get(term.name)
-        defs.append(_definition(term.path, ref, common, any(k in d for d in finals for k in _PATH_ONLY)))
+        a = drawing.a[mine]
+        turned = bool((np.abs(a.imag) > 1e-9 * np.abs(a)).any() or (a.real < 0).any())
+        path_only = turned or any(k in d for d in finals for k in _PATH_ONLY)
+        defs.append(_definition(term.path, ref, common, path_only))
         for s, d in zip(used_styles, finals, strict=True):
             rest = {k: v for k, v in d.items() if k not in common}
             template, lengths = _template(rest, varying=not constant)

@@ -401,3 +401,24 @@ def test_inkscape_sees_the_groups_and_the_clones(tmp_path) -> None:
     found = check_document(out.read_text(encoding="utf-8"))
     assert sum(i.startswith(("P1-", "P2-", "X1-", "Z-")) for i in ids) == len(found)  # every group
     assert sum(i.startswith("use") for i in ids) == len(drawing)  # every clone, with its bounding box
+
+
+def test_a_turned_circle_or_rectangle_is_defined_as_a_path() -> None:
+    """Readers that turn a ``<use>`` of a ``<rect>`` into points may drop its rotation: paths are safe."""
+    g = parse_grammar(
+        "lsys 2\n"
+        'terminal C "M2 0 C2 1.1 1.1 2 0 2 C-1.1 2 -2 1.1 -2 0 C-2 -1.1 -1.1 -2 0 -2 C1.1 -2 2 -1.1 2 0 Z"'
+        ' style "fill:#c00"\n'
+        'terminal R "M0 0 H4 V2 H0 Z" style "fill:#0a0"\n'
+        "axiom: P(3) [ f(30) Q(5) ]\n"
+        "P(m): m > 0 -> C f(6) P(m-1)\n"
+        "P(m): m == 0 -> C\n"
+        "Q(m): m > 0 -> R +(30) f(6) Q(m-1)\n"
+        "Q(m): m == 0 -> R\n"
+    )
+    drawing = derive(g)
+    root = parse(drawing_to_structured_svg(drawing))
+    defs = {el.get("id"): local(el) for d in root.iter(f"{{{SVG_NS}}}defs") for el in d}
+    assert defs["C"] == "circle"  # only moved: stays a circle
+    assert defs["R"] == "path"  # turned by 30° a step
+    assert_scenes_close(parse_svg(drawing_to_structured_svg(drawing)), drawing_scene(drawing))
