@@ -4,10 +4,10 @@ A designer who opens the file sees what repeats:
 
 - every terminal is written once, in ``<defs>``, with its name as ``id`` (``A``, ``leaf``);
   a terminal that is a circle, an ellipse, a rectangle or a line is written as that element
-  (:func:`~lsys_core.render.primitives.primitive`) when no instance turns it; a turned one is
-  written as a ``<path>``, because a widely used reader (svgelements 1.9) drops the rotation
-  of a ``<use>`` when it turns a ``<rect>``, ``<circle>`` or ``<ellipse>`` into points (the
-  rendered pixels agree, its geometry does not);
+  (:func:`~lsys_core.render.primitives.primitive`) when neither it nor an instance is
+  turned; a turned one is written as a ``<path>``, because a widely used reader
+  (svgelements 1.9) drops the rotation of a ``<rect>``, ``<circle>`` or ``<ellipse>`` when
+  it turns one into points (the rendered pixels agree, its geometry does not);
 - every instance is a ``<use xlink:href="#A" transform="…">`` (a clone in Inkscape: edit the
   shape once, every copy follows), with ``translate``/``rotate``/``scale`` written only where
   they are not the identity.  ``xlink:href`` rather than SVG 2's plain ``href``: Inkscape 1.2
@@ -242,6 +242,8 @@ def _definition(path: str, ref: str, common: dict[str, str], path_only: bool) ->
     """Return a terminal's element for ``<defs>``."""
     style = f' style="{_attr(css_text(common))}"' if common else ""
     shape = None if path_only else primitive(path)
+    if shape is not None and "transform" in shape[1]:
+        shape = None  # a turned rectangle or ellipse: a path (see the module docstring)
     if shape is None:
         return f'<path id="{_attr(ref)}" d="{_attr(_compact(path))}"{style}/>\n'
     tag, attrs = shape
