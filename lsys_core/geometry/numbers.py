@@ -14,6 +14,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from lsys_core.errors import LimitError
+
 __all__ = ["COMMAND_LETTERS", "Lexed", "lex", "numbers_from_text"]
 
 _INVALID, _SPACE, _COMMA, _DIGIT, _DOT, _SIGN, _EXP, _LETTER = range(8)
@@ -40,57 +42,80 @@ for _c in COMMAND_LETTERS:
 class Lexed(NamedTuple):
     """Tokens of a text: numbers with their byte offsets, command letters with theirs.
 
-    ``error`` is the byte offset of the first character that is not part of a valid token (the
-    text is lexed up to there), or -1.
+    ``errors`` holds the byte offsets of every character that is not part of a valid token and
+    of every malformed number (those are left out of ``values``), in increasing order; ``error``
+    is the first of them, or -1.
     """
 
     values: np.ndarray
     starts: np.ndarray
     letters: np.ndarray
     letter_pos: np.ndarray
-    error: int
+    errors: np.ndarray
+
+    @property
+    def error(self) -> int:
+        """The offset of the first error, or -1."""
+        return int(self.errors[0]) if self.errors.size else -1
+
+    def before(self, offset: int) -> Lexed:
+        """Return the tokens that start before ``offset`` (the text as read up to an error)."""
+        k = int(np.searchsorted(self.starts, offset))
+        j = int(np.searchsorted(self.letter_pos, offset))
+        return Lexed(self.values[:k], self.starts[:k], self.letters[:j], self.letter_pos[:j], self.errors)
 
 
-def lex(text: str | bytes, *, letters: bool = True, chunk: int = CHUNK) -> Lexed:
+def lex(
+    text: str | bytes, *, letters: bool = True, chunk: int = CHUNK, max_numbers: int | None = None
+) -> Lexed:
     """Split path data (``letters``) or a number list into numbers and command letters.
 
     Parameters
     ----------
     text : str or bytes
-        The attribute value.  Non-ASCII characters are errors.
+        The attribute value (or several, joined by newlines).  Non-ASCII characters are errors.
     letters : bool
         Whether path command letters are tokens (otherwise they are errors).
     chunk : int
         Bytes lexed at a time (bounds the temporary memory).
+    max_numbers : int, optional
+        Most numbers accepted (checked after each chunk, before more memory is used).
 
     Returns
     -------
     Lexed
+
+    Raises
+    ------
+    LimitError
+        The text holds more than ``max_numbers`` numbers.
     """
     raw = text.encode("ascii", "replace") if isinstance(text, str) else bytes(text)
     whole = np.frombuffer(raw, dtype=np.uint8)
     parts: list[tuple[np.ndarray, ...]] = []
-    error = -1
     a = 0
+    count = 0
     n = whole.size
     while a < n:
         b = _cut(whole, a + chunk)
-        vals, starts, lets, lpos, err = _lex_chunk(whole[a:b], letters)
-        parts.append((vals, starts + a, lets, lpos + a))
-        if err >= 0:
-            error = a + err
-            break
+        vals, starts, lets, lpos, errs = _lex_chunk(whole[a:b], letters)
+        parts.append((vals, starts + a, lets, lpos + a, errs + a))
+        count += vals.size
+        if max_numbers is not None and count > max_numbers:
+            raise LimitError(f"more than {max_numbers:,} numbers in path data")
         a = b
     if not parts:
         z = np.zeros(0, dtype=np.int64)
-        return Lexed(np.zeros(0), z, np.zeros(0, np.uint8), z, error)
+        return Lexed(np.zeros(0), z, np.zeros(0, np.uint8), z, z)
     cols = [np.concatenate(col) for col in zip(*parts, strict=True)]
-    return Lexed(cols[0], cols[1], cols[2], cols[3], error)
+    return Lexed(cols[0], cols[1], cols[2], cols[3], cols[4])
 
 
 def numbers_from_text(text: str) -> tuple[np.ndarray, int]:
-    """Return the numbers of a list such as ``points="1,2 3-4"`` and the offset of the first error (-1)."""
+    """Return the numbers of a list such as ``points="1,2 3-4"`` up to the first error, and its offset (-1)."""
     lexed = lex(text, letters=False)
+    if lexed.errors.size:
+        lexed = lexed.before(lexed.error)
     return lexed.values, lexed.error
 
 
@@ -110,14 +135,13 @@ def _cut(b: np.ndarray, at: int) -> int:
 
 
 def _lex_chunk(b: np.ndarray, letters: bool):
-    """Lex one chunk (no token crosses its ends): values, starts, letters, their offsets, error."""
+    """Lex one chunk (no token crosses its ends): values, starts, letters, their offsets, errors."""
     cls = _CLASS[b]
     if not letters:
         cls = np.where(cls == _LETTER, np.int8(_INVALID), cls)
-    bad = np.flatnonzero(cls == _INVALID)
-    error = int(bad[0]) if bad.size else -1
-    if error >= 0:
-        b, cls = b[:error], cls[:error]
+    invalid = np.flatnonzero(cls == _INVALID)
+    if invalid.size:
+        cls = np.where(cls == _INVALID, np.int8(_SPACE), cls)  # an error, then read on
     n = cls.size
     numeric = (cls >= _DIGIT) & (cls <= _EXP)
     prev_num = np.zeros(n, dtype=bool)
@@ -140,52 +164,42 @@ def _lex_chunk(b: np.ndarray, letters: bool):
     nonnum = np.flatnonzero(~numeric)
     run_end = np.append(nonnum, n)[np.searchsorted(nonnum, starts)]
     ends = np.minimum(np.append(starts[1:], n), run_end)
-    tok_error = _first_malformed(b, cls, starts, ends, start)
-    if tok_error >= 0:
-        error = tok_error
-        k = int(np.searchsorted(starts, tok_error))
-        starts, ends = starts[:k], ends[:k]
-        b, cls, numeric = b[:tok_error], cls[:tok_error], numeric[:tok_error]
+    bad = _malformed(cls, starts, ends)
+    errors = invalid
+    if bad.any():
+        errors = np.union1d(invalid, starts[bad])
+        # Leave malformed numbers out: their characters become separators.
+        tok = np.cumsum(start, dtype=np.int32) - 1
+        numeric = numeric & ~bad[np.maximum(tok, 0)]
+        starts, ends = starts[~bad], ends[~bad]
     lpos = np.flatnonzero(cls == _LETTER)
     values = _values(b, numeric, starts, ends)
-    return values, starts.astype(np.int64), b[lpos], lpos.astype(np.int64), error
+    return values, starts.astype(np.int64), b[lpos], lpos.astype(np.int64), errors.astype(np.int64)
 
 
-def _first_malformed(b, cls, starts, ends, start) -> int:
-    """Return the offset of the first malformed number token (no mantissa digit, bad exponent), or -1."""
+def _malformed(cls, starts, ends) -> np.ndarray:
+    """Mark the malformed number tokens: no mantissa digit, or a bad or second exponent."""
+    bad = np.zeros(starts.size, dtype=bool)
     if starts.size == 0:
-        return -1
+        return bad
     n = cls.size
     pad = np.append(cls, np.int8(_SPACE))
 
     def at(i):
         return pad[np.minimum(i, n)]
 
-    s = starts
-    c0 = at(s)
-    m = s + (c0 == _SIGN)  # first mantissa character
+    m = starts + (at(starts) == _SIGN)  # first mantissa character
     cm, cm1 = at(m), at(m + 1)
-    mant_ok = ((cm == _DIGIT) | ((cm == _DOT) & (cm1 == _DIGIT))) & (m < ends)
-    bad = ~mant_ok
+    bad |= ~(((cm == _DIGIT) | ((cm == _DOT) & (cm1 == _DIGIT))) & (m < ends))
     exps = np.flatnonzero(cls == _EXP)
     if exps.size:
-        tok = np.searchsorted(starts, exps, side="right") - 1
-        after = at(exps + 1)
-        after2 = at(exps + 2)
-        exp_ok = (after == _DIGIT) | ((after == _SIGN) & (after2 == _DIGIT))
-        exp_ok &= tok >= 0
-        # The exponent must lie inside its token, and a token holds at most one.
-        inside = exps < ends[np.maximum(tok, 0)]
+        tok = np.searchsorted(starts, exps, side="right") - 1  # every exponent lies in a token
+        after, after2 = at(exps + 1), at(exps + 2)
+        ok = (after == _DIGIT) | ((after == _SIGN) & (after2 == _DIGIT))
         dup = np.zeros(exps.size, dtype=bool)
         dup[1:] = tok[1:] == tok[:-1]
-        wrong = ~(exp_ok & inside) | dup
-        if wrong.any():
-            bad[tok[wrong & (tok >= 0)]] = True
-            lone = exps[wrong & (tok < 0)]
-            if lone.size:
-                return int(lone[0])
-    hit = np.flatnonzero(bad)
-    return int(starts[hit[0]]) if hit.size else -1
+        bad[tok[~ok | dup]] = True
+    return bad
 
 
 def _values(b: np.ndarray, numeric: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:

@@ -19,9 +19,22 @@ import numpy as np
 
 from lsys_core.geometry.numbers import lex
 
-__all__ = ["ARC", "CLOSE", "CUBIC", "LINE", "MOVE", "QUAD", "PathTable", "parse_path"]
+__all__ = [
+    "ARC",
+    "CLOSE",
+    "CUBIC",
+    "LINE",
+    "MAX_NUMBER",
+    "MOVE",
+    "QUAD",
+    "PathTable",
+    "parse_path",
+    "parse_paths",
+]
 
 MOVE, LINE, QUAD, CUBIC, ARC, CLOSE = range(6)
+#: Numbers beyond this magnitude make the whole path unreadable (they mean broken data).
+MAX_NUMBER = 1e15
 
 _ARITY = np.zeros(256, dtype=np.intp)
 _OP = np.full(256, -1, dtype=np.int8)
@@ -43,55 +56,119 @@ for _ch, _k, _op in (
 
 
 class PathTable(NamedTuple):
-    """Path data as one row per segment, in absolute coordinates.
+    """Path data (of one or several paths) as one row per segment, in absolute coordinates.
 
     ``op`` is the kind of each row (:data:`MOVE`, :data:`LINE`, :data:`QUAD`, :data:`CUBIC`,
     :data:`ARC`, :data:`CLOSE`); ``pts`` its control points ``p0 c1 c2 p3`` (``p0 p0 p3 p3`` for
     lines, moves, closes and arcs, ``p0 q q p3`` for quadratics); ``arc`` holds ``rx ry phi
-    large sweep`` for each arc row, in row order.  ``error`` names the first problem (None: all
-    of the data was read).
+    large sweep`` for each arc row, in row order; ``path`` the path of each row (rows of one
+    path are consecutive).  ``errors`` names the first problem of each path (None: all of its
+    data was read).
     """
 
     op: np.ndarray
     pts: np.ndarray
     arc: np.ndarray
-    error: str | None
+    path: np.ndarray
+    errors: tuple[str | None, ...]
+
+    @property
+    def error(self) -> str | None:
+        """The first problem of the first path (for a table of one path)."""
+        return self.errors[0] if self.errors else None
 
 
-def _empty(error: str | None) -> PathTable:
-    return PathTable(np.zeros(0, np.int8), np.zeros((0, 4), complex), np.zeros((0, 5)), error)
+def _empty(errors: tuple[str | None, ...]) -> PathTable:
+    z = np.zeros(0, dtype=np.intp)
+    return PathTable(np.zeros(0, np.int8), np.zeros((0, 4), complex), np.zeros((0, 5)), z, errors)
 
 
 def parse_path(d: str) -> PathTable:
-    """Parse SVG path data (see the module docstring)."""
-    lexed = lex(d)
-    letters, lpos, values, starts = lexed.letters, lexed.letter_pos, lexed.values, lexed.starts
-    error = None if lexed.error < 0 else f"unexpected character at offset {lexed.error}"
-    if letters.size == 0:
-        return _empty("no commands" if values.size or error else error)
-    if (values.size and starts[0] < lpos[0]) or letters[0] not in (ord("M"), ord("m")):
-        return _empty("path data must begin with a move command (M or m)")
+    """Parse the path data of one path (see the module docstring)."""
+    return parse_paths([d])
+
+
+def parse_paths(ds: list[str], max_numbers: int | None = None) -> PathTable:
+    """Parse the path data of several paths at once (one lexing pass, one resolution pass).
+
+    Each path is read on its own, as if alone: its first move is absolute and an error in it
+    ends only that path.  ``max_numbers`` bounds the numbers read, all paths together
+    (:class:`~lsys_core.errors.LimitError` beyond).
+    """
+    n_paths = len(ds)
+    lens = np.fromiter((len(d) for d in ds), dtype=np.int64, count=n_paths)
+    offs = np.cumsum(lens + 1) - (lens + 1)  # each path's first byte in the joined text
+    ends = offs + lens
+    joined = "\n".join(ds)
+    lexed = lex(joined, max_numbers=max_numbers)
+    values, starts, letters, lpos = lexed.values, lexed.starts, lexed.letters, lexed.letter_pos
+    messages: list[str | None] = [None] * n_paths
+    # Each path is read up to its first error.
+    cut = ends.copy()
+    if lexed.errors.size:
+        err_path = np.searchsorted(offs, lexed.errors, side="right") - 1
+        first_err, where = np.unique(err_path, return_index=True)
+        cut[first_err] = lexed.errors[where]
+        for p, e in zip(first_err.tolist(), lexed.errors[where].tolist(), strict=True):
+            messages[p] = f"unexpected character at offset {e - int(offs[p])}"
+    tok_path = np.searchsorted(offs, starts, side="right") - 1
+    let_path = np.searchsorted(offs, lpos, side="right") - 1
+    # A path with a number beyond MAX_NUMBER is not read at all (its sums would overflow).
+    huge = ~(np.abs(values) <= MAX_NUMBER)
+    if huge.any():
+        for p in np.unique(tok_path[huge]).tolist():
+            cut[p] = offs[p]
+            messages[p] = f"a number beyond {MAX_NUMBER:.0e}"
+    keep_tok = starts < cut[tok_path]
+    keep_let = lpos < cut[let_path]
+    # A path must begin with a move: its first token is an M or m.
+    first_let = np.full(n_paths, np.iinfo(np.int64).max)
+    np.minimum.at(first_let, let_path[keep_let], lpos[keep_let])
+    first_num = np.full(n_paths, np.iinfo(np.int64).max)
+    np.minimum.at(first_num, tok_path[keep_tok], starts[keep_tok])
+    letter_at_first = np.zeros(n_paths, dtype=np.uint8)
+    has_let = first_let < np.iinfo(np.int64).max
+    if keep_let.any():
+        first_idx = np.searchsorted(lpos, first_let[has_let])
+        letter_at_first[has_let] = letters[first_idx]
+    good_start = has_let & (first_let < first_num) & np.isin(letter_at_first, (ord("M"), ord("m")))
+    for p in np.flatnonzero(~good_start & (lens > 0)).tolist():
+        if messages[p] is None or has_let[p]:
+            messages[p] = "path data must begin with a move command (M or m)"
+    keep_tok &= good_start[tok_path]
+    keep_let &= good_start[let_path]
+    values, starts, tok_path = values[keep_tok], starts[keep_tok], tok_path[keep_tok]
+    letters, lpos, let_path = letters[keep_let], lpos[keep_let], let_path[keep_let]
     first = np.searchsorted(starts, lpos)  # first number after each command letter
     count = np.diff(first, append=values.size)
-    del starts
     arity = _ARITY[letters]
-    values, first, count = _fix_arc_flags(d, letters, lpos, values, first, count, arity)
+    values, first, count = _fix_arc_flags(
+        joined, letters, lpos, np.minimum(cut, ends)[let_path], values, first, count
+    )
     div = np.maximum(arity, 1)
     ok = np.where(arity == 0, count == 0, (count > 0) & (count % div == 0))
     groups = np.where(arity == 0, 1, count // div)
     bad = np.flatnonzero(~ok)
     if bad.size:
-        stop = int(bad[0])
-        what = "numbers after Z" if arity[stop] == 0 else "incomplete arguments"
-        error = error or f"{what} for command {chr(letters[stop])} (number {stop + 1})"
-        # Complete argument groups before the error still count (implicit repetition).
-        groups = groups[: stop + 1]
-        letters, first, arity = letters[: stop + 1], first[: stop + 1], arity[: stop + 1]
-    return _execute(letters, first, arity, groups, values, error)
+        # The first bad command of a path keeps its complete groups; the path ends there.
+        bad_paths, where = np.unique(let_path[bad], return_index=True)
+        stop_at = np.full(n_paths, np.iinfo(np.int64).max)
+        stop_at[bad_paths] = bad[where]
+        keep = np.arange(letters.size) <= stop_at[let_path]
+        for p, c in zip(bad_paths.tolist(), bad[where].tolist(), strict=True):
+            if messages[p] is None:
+                what = "numbers after Z" if arity[c] == 0 else "incomplete arguments"
+                ordinal = c - int(np.searchsorted(let_path, p))
+                messages[p] = f"{what} for command {chr(letters[c])} (number {ordinal + 1})"
+        letters, first, arity, groups, let_path = (x[keep] for x in (letters, first, arity, groups, let_path))
+    return _execute(letters, first, arity, groups, let_path, values, n_paths, tuple(messages))
 
 
-def _fix_arc_flags(d, letters, lpos, values, first, count, arity):
-    """Re-read arc commands whose flags are written without separators (``0 011 1``)."""
+def _fix_arc_flags(text, letters, lpos, limit, values, first, count):
+    """Re-read arc commands whose flags are written without separators (``0 011 1``).
+
+    ``limit`` is, per command, where its path's readable text ends.
+    """
     is_arc = (letters == ord("A")) | (letters == ord("a"))
     if not is_arc.any():
         return values, first, count
@@ -107,20 +184,46 @@ def _fix_arc_flags(d, letters, lpos, values, first, count, arity):
     suspect[arcs[(count[arcs] % 7 != 0) | (count[arcs] == 0)]] = True
     if not suspect.any():
         return values, first, count
-    raw = d.encode("ascii", "replace")
+    raw = text.encode("ascii", "replace")
     extra: list[np.ndarray] = []
     first = first.copy()
     count = count.copy()
     offset = values.size
     for c in np.flatnonzero(suspect).tolist():
         end = int(lpos[c + 1]) if c + 1 < lpos.size else len(raw)
-        nums = _arc_args(raw[int(lpos[c]) + 1 : end])
+        nums = _arc_args(raw[int(lpos[c]) + 1 : min(end, int(limit[c]))])
         extra.append(nums)
         first[c], count[c] = offset, nums.size
         offset += nums.size
     if extra:
         values = np.concatenate([values, *extra])
     return values, first, count
+
+
+def _scan_number(text: bytes, i: int) -> int:
+    """Return the end of the number starting at ``text[i]`` (``i`` itself if there is none)."""
+    n = len(text)
+    j = i
+    if j < n and text[j] in b"+-":
+        j += 1
+    digits = 0
+    while j < n and 48 <= text[j] <= 57:
+        j, digits = j + 1, digits + 1
+    if j < n and text[j] == 46:  # "."
+        j += 1
+        while j < n and 48 <= text[j] <= 57:
+            j, digits = j + 1, digits + 1
+    if digits == 0:
+        return i
+    if j < n and text[j] in b"eE":
+        k = j + 1
+        if k < n and text[k] in b"+-":
+            k += 1
+        if k < n and 48 <= text[k] <= 57:
+            while k < n and 48 <= text[k] <= 57:
+                k += 1
+            j = k
+    return j
 
 
 def _arc_args(text: bytes) -> np.ndarray:
@@ -138,14 +241,11 @@ def _arc_args(text: bytes) -> np.ndarray:
             out.append(float(text[i] - 48))
             i += 1
             continue
-        j = i + 1
-        while j < n and text[j] not in b" \t\r\n\f,":
-            j += 1
-        lexed = lex(text[i:j], letters=False)
-        if lexed.values.size == 0:
+        j = _scan_number(text, i)
+        if j == i:
             break
-        out.append(float(lexed.values[0]))
-        i += int(lexed.starts[1]) if lexed.starts.size > 1 else j - i
+        out.append(float(text[i:j]))
+        i = j
     if len(out) % 7:
         out = [*out[: len(out) - len(out) % 7], np.nan]  # incomplete group: marks the error
     return np.asarray(out, dtype=float)
@@ -158,15 +258,16 @@ def _reset_sum(values: np.ndarray, reset: np.ndarray) -> np.ndarray:
     return values[last] * reset[last] + cs - cs[last]
 
 
-def _execute(letters, first, arity, groups, values, error) -> PathTable:
+def _execute(letters, first, arity, groups, let_path, values, n_paths, errors) -> PathTable:
     """Expand commands into rows and resolve them to absolute coordinates."""
     n = int(groups.sum())
     if n == 0:
-        return _empty(error)
+        return _empty(errors)
     cmd = np.repeat(np.arange(letters.size), groups)
     g = np.arange(n) - np.repeat(np.cumsum(groups) - groups, groups)  # group index within command
     k = arity[cmd]
     base_idx = first[cmd] + g * k
+    path = let_path[cmd]
     del cmd
     letter = np.repeat(letters, groups)
     rel = letter >= ord("a")
@@ -180,7 +281,9 @@ def _execute(letters, first, arity, groups, values, error) -> PathTable:
     is_move = (up == ord("M")) & (g == 0)
     op[(up == ord("M")) & (g > 0)] = LINE  # implicit lines after a move
     del g
-    rel[:1] = False  # a leading "m" is absolute
+    path_first = np.ones(n, dtype=bool)
+    path_first[1:] = path[1:] != path[:-1]
+    rel[path_first] = False  # the leading "m" of a path is absolute
     # The end point of every row: set (absolute) or moved (relative) in x and in y.
     ex = np.zeros(n)
     ey = np.zeros(n)
@@ -225,7 +328,7 @@ def _execute(letters, first, arity, groups, values, error) -> PathTable:
         pts[t, 1] = pts[t, 2] = qc[t]
     a = np.flatnonzero(up == ord("A"))
     arc = np.stack([arg(j, a) for j in range(5)], axis=1) if a.size else np.zeros((0, 5))
-    return PathTable(op, pts, arc, error)
+    return PathTable(op, pts, arc, path, errors)
 
 
 def _group_offsets(is_move, close, setc, e):

@@ -15,20 +15,22 @@ from typing import NamedTuple
 
 import numpy as np
 
-from lsys_core.errors import SvgError
+from lsys_core.errors import LimitError, SvgError
 from lsys_core.geometry import pathdata as pd
-from lsys_core.geometry.pathdata import PathTable, parse_path
+from lsys_core.geometry.pathdata import PathTable, parse_path, parse_paths
 
 __all__ = [
     "ArrayPath",
     "RawPath",
     "arc_cubics",
+    "arrays_from_table",
     "assemble",
     "cubics_from_d",
     "cubics_from_path",
     "cubics_from_table",
     "d_from_cubics",
     "path_from_d",
+    "paths_from_ds",
     "raw_from_segments",
 ]
 
@@ -172,6 +174,12 @@ def path_from_d(d: str) -> tuple[ArrayPath, str | None]:
     return ArrayPath(*cubics_from_table(table)), table.error
 
 
+def paths_from_ds(ds: list[str]) -> list[tuple[ArrayPath, str | None]]:
+    """Parse the path data of many paths in one pass (see :func:`path_from_d`)."""
+    table = parse_paths(ds)
+    return list(zip(arrays_from_table(table, len(ds)), table.errors, strict=True))
+
+
 def assemble(paths: list[ArrayPath]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Concatenate paths into one cubic array.
 
@@ -256,10 +264,47 @@ def cubics_from_table(table: PathTable) -> tuple[np.ndarray, np.ndarray, tuple[b
     closed : tuple of bool
         Whether each subpath ends with ``Z``.
     """
+    cub, sub, closed, _ = _convert(table)
+    return cub, sub, tuple(closed)
+
+
+def arrays_from_table(
+    table: PathTable, n_paths: int, max_segments: int | None = None, name: str = "the path data"
+) -> list[ArrayPath]:
+    """Convert a table of several paths (:func:`~lsys_core.geometry.pathdata.parse_paths`).
+
+    Returns one :class:`ArrayPath` per path (see :func:`cubics_from_table`); their arrays are
+    views of one array.
+
+    Raises
+    ------
+    LimitError
+        The paths have more than ``max_segments`` cubic segments (checked before allocating them).
+    """
+    cub, sub, closed, seg_path = _convert(table, max_segments, name)
+    bounds = np.searchsorted(seg_path, np.arange(n_paths + 1))
+    # Subpaths are numbered per path: subtract each path's first subpath number.
+    first_sub = np.append(sub, 0)[bounds[:-1]]
+    sub = sub - np.repeat(first_sub, np.diff(bounds))
+    out = []
+    sub_lo = 0
+    for p in range(n_paths):
+        a, b = int(bounds[p]), int(bounds[p + 1])
+        n_sub = int(sub[b - 1]) + 1 if b > a else 0
+        out.append(ArrayPath(cub[a:b], sub[a:b], tuple(closed[sub_lo : sub_lo + n_sub])))
+        sub_lo += n_sub
+    return out
+
+
+def _convert(
+    table: PathTable, max_segments: int | None = None, name: str = ""
+) -> tuple[np.ndarray, np.ndarray, list[bool], np.ndarray]:
+    """Rows to cubics: ``(cubics, subpath numbers, closed flag per subpath, path of each segment)``."""
     op, pts = table.op, table.pts
     n = op.size
     if n == 0:
-        return _empty()
+        c, s, _ = _empty()
+        return c, s, [], s
     is_move = op == pd.MOVE
     is_close = op == pd.CLOSE
     after_close = np.zeros(n, dtype=bool)
@@ -281,8 +326,7 @@ def cubics_from_table(table: PathTable) -> tuple[np.ndarray, np.ndarray, tuple[b
     kinds[op == pd.QUAD] = _QUAD
     kinds[op == pd.CUBIC] = _CUBIC
     arc_rows = np.flatnonzero(op == pd.ARC)  # table.arc has one row per arc row, in order
-    rows = np.ones(n, dtype=bool)
-    rows[is_move] = False
+    rows = ~is_move
     degenerate = (pts[:, 0] == pts[:, 1]) & (pts[:, 1] == pts[:, 2]) & (pts[:, 2] == pts[:, 3])
     rows &= ~degenerate
     curved = np.zeros(0, dtype=np.intp)
@@ -297,26 +341,27 @@ def cubics_from_table(table: PathTable) -> tuple[np.ndarray, np.ndarray, tuple[b
     if curved.size == 0:
         cub = pts[keep]
         _elevate(cub, kinds[keep])
-        seg_sub = sub[keep]
+        seg_row = keep
     else:
         # Every kept row takes one slot, every curved arc as many as it has pieces, in row order.
         setup = _arc_setup(pts[curved, 0], pts[curved, 3], table.arc[sel])
         slots = rows.astype(np.intp)
         slots[curved] = setup.pieces
         offset = np.cumsum(slots) - slots
+        if max_segments is not None and int(slots.sum()) > max_segments:
+            raise LimitError(f"{name} has more than {max_segments:,} path segments")
         cub = np.empty((int(slots.sum()), 4), dtype=complex)
         plain = pts[keep]
         _elevate(plain, kinds[keep])
         cub[offset[keep]] = plain
         del plain
         _fill_arcs(cub, offset[curved], setup, pts[curved, 0], pts[curved, 3])
-        seg_sub = np.repeat(sub, slots)
-    if cub.shape[0] == 0:
-        return _empty()
+        seg_row = np.repeat(np.arange(n), slots)
+    seg_sub = sub[seg_row]
     change = np.ones(seg_sub.size, dtype=bool)
     change[1:] = seg_sub[1:] != seg_sub[:-1]  # subpath numbers never decrease: renumber the runs
     subpaths = np.cumsum(change) - 1
-    return cub, subpaths, tuple(closed_sub[seg_sub[change]].tolist())
+    return cub, subpaths, closed_sub[seg_sub[change]].tolist(), table.path[seg_row]
 
 
 #: Arcs converted at a time (bounds the temporary memory of the conversion).
@@ -443,6 +488,8 @@ def cubics_from_d(d: str) -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
     """
     table = parse_path(d)
     if table.error is not None:
+        if table.error.startswith("a number beyond"):
+            raise SvgError("path data has non-finite or huge coordinates")
         snippet = d if len(d) <= 40 else d[:37] + "..."
         raise SvgError(f"invalid path data {snippet!r}: {table.error}")
     return cubics_from_table(table)

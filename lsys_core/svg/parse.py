@@ -1,32 +1,49 @@
 """Read an SVG file into a :class:`~lsys_core.svg.model.Scene`, safely.
 
-The bytes are checked before any SVG library sees them: size, binary junk, XML
-attacks (entities, internal DTD subsets), nesting depth, ``<use>`` cycles and
-``<use>`` fan-out.  The checked tree is re-serialised (without DTD, with the
-content of ``<symbol>``, ``<mask>`` and ``<marker>`` moved out of the drawing
-flow) and handed to svgelements, which resolves CSS, inheritance, ``<use>`` and
-transforms.  Each drawable shape becomes an :class:`~lsys_core.svg.model.Element`
-with cubic Bézier arrays in viewBox user units and a resolved style string.
+The bytes are checked and parsed by :mod:`lsys_core.svg.xmlsafe` (size, XML attacks, element and
+nesting limits, while reading); :mod:`lsys_core.svg.uses` measures what ``<use>`` references
+expand to before anything is expanded; :class:`~lsys_core.svg.walk.Reader` then draws the
+document the way a renderer does, into elements (geometry in document coordinates, the style it
+draws with, its place in the paint order), definitions and content kept as is.
 """
 
 from __future__ import annotations
 
 import gc
+import math
 import os
+import sys
+from collections import Counter
 from pathlib import Path
 
+import numpy as np
+
 from lsys_core.errors import LimitError, SvgError
-from lsys_core.svg.extract import extract
-from lsys_core.svg.model import Scene
-from lsys_core.svg.prepare import prepare
+from lsys_core.geometry.paths import MAX_COORD
+from lsys_core.grammar.model import Verbatim
+from lsys_core.quoting import quote_name
+from lsys_core.svg.model import Element, Scene
+from lsys_core.svg.style import DEFAULT_FONT_SIZE, font_size_px
+from lsys_core.svg.tree import Tree, local_name, shown
+from lsys_core.svg.uses import check_expansion
+from lsys_core.svg.values import IDENTITY, Viewport, parse_length, parse_viewbox, to_user, viewbox_transform
+from lsys_core.svg.walk import Ctx, Reader, ShapeRecord, VerbatimRecord
 from lsys_core.svg.xmlsafe import (
     DEFAULT_MAX_BYTES,
     DEFAULT_MAX_DEPTH,
     DEFAULT_MAX_ELEMENTS,
     maybe_gunzip,
+    read_xml,
 )
 
 __all__ = ["DEFAULT_MAX_BYTES", "DEFAULT_MAX_DEPTH", "DEFAULT_MAX_ELEMENTS", "load_svg", "parse_svg"]
+
+_ABSOLUTE = ("", "px", "pt", "pc", "mm", "cm", "in", "q")
+
+
+def _display_name(name: str) -> str:
+    """A file name for messages: as is when plain, quoted and escaped otherwise (like ``ls``)."""
+    return name if name == "<string>" else quote_name(name)
 
 
 def load_svg(
@@ -45,7 +62,7 @@ def load_svg(
     max_bytes : int
         Largest accepted file size (also for the decompressed content of SVGZ).
     max_elements : int
-        Largest accepted number of elements once ``<use>`` references are expanded.
+        Largest accepted number of elements, read or drawn (``<use>`` references expanded).
     max_depth : int
         Deepest accepted element nesting (``<use>`` references count as nesting).
 
@@ -61,14 +78,15 @@ def load_svg(
         The file exceeds one of the limits.
     """
     p = Path(path)
+    shown_name = _display_name(str(p))
     try:
         size = p.stat().st_size
         if size > max_bytes:
-            raise LimitError(f"{p} is too large ({size:,} bytes; the limit is {max_bytes:,})")
+            raise LimitError(f"{shown_name} is too large ({size:,} bytes; the limit is {max_bytes:,})")
         with open(p, "rb") as fh:
             data = fh.read(max_bytes + 1)
     except OSError as exc:
-        raise SvgError(f"cannot read {p}: {exc.strerror or exc}") from exc
+        raise SvgError(f"cannot read {shown_name}: {exc.strerror or exc}") from exc
     return parse_svg(data, max_bytes=max_bytes, max_elements=max_elements, max_depth=max_depth, name=str(p))
 
 
@@ -80,30 +98,135 @@ def parse_svg(
     max_depth: int = DEFAULT_MAX_DEPTH,
     name: str = "<string>",
 ) -> Scene:
-    """Parse SVG text or bytes into a scene (see :func:`load_svg`).
-
-    ``name`` is used in messages.
-    """
+    """Parse SVG text or bytes into a scene (see :func:`load_svg`); ``name`` is used in messages."""
+    name = _display_name(name)
     data = source.encode("utf-8") if isinstance(source, str) else bytes(source)
     if len(data) > max_bytes:
         raise LimitError(f"{name} is too large ({len(data):,} bytes; the limit is {max_bytes:,})")
     data = maybe_gunzip(data, max_bytes, name)
-    source_bytes = len(data)
-    prepared = prepare(source if isinstance(source, str) else data, max_elements, max_depth, name)
+    root = read_xml(data, name, max_elements, max_depth)
+    if local_name(root.tag) != "svg":
+        tag = str(root.tag).rpartition("}")[2]
+        shown_tag = f"<{tag}>" if tag.isprintable() and tag.isascii() else shown(tag)
+        raise SvgError(f"not an SVG: {name}: the root element is {shown_tag}, not <svg>")
+    tree = Tree(root)
+    check_expansion(tree, max_elements, max_depth, name)
     was_enabled = gc.isenabled()
     gc.disable()
+    old_limit = sys.getrecursionlimit()
+    sys.setrecursionlimit(max(old_limit, 8 * max_depth + 1000))
     try:
-        elements, skips = extract(prepared, name)
+        reader = Reader(tree, name, max_elements, max_depth)
+        viewbox, size, ctx = _root_context(reader, root)
+        reader.walk(root, ctx)
+        elements, skips = _elements(reader)
     finally:
+        sys.setrecursionlimit(old_limit)
         if was_enabled:
             gc.enable()
+    warnings = [*reader.notes, *_skip_messages(skips), *_kept_messages(reader.kept)]
     if not elements:
-        detail = f" ({'; '.join(skips.messages())})" if skips.counts else ""
+        reasons = [
+            *_skip_messages(skips),
+            *(n for n in reader.notes if "cycle" in n),
+            *_kept_messages(reader.kept),
+        ]
+        detail = f" ({'; '.join(reasons)})" if reasons else ""
         raise SvgError(f"no drawable elements in {name}{detail}")
+    verbatim = tuple(
+        Verbatim(r.order, r.xml, r.what) for r in reader.records if isinstance(r, VerbatimRecord)
+    )
     return Scene(
         elements=tuple(elements),
-        viewbox=prepared.viewbox,
-        size=prepared.size,
-        warnings=(*prepared.notes, *skips.messages()),
-        source_bytes=source_bytes,
+        viewbox=viewbox,
+        size=size,
+        warnings=tuple(dict.fromkeys(warnings)),
+        source_bytes=len(data),
+        defs=reader.resources.markup(),
+        verbatim=verbatim,
     )
+
+
+def _root_context(reader: Reader, root) -> tuple:
+    """The canvas (viewBox, size) and the context the root is drawn in."""
+    notes = reader.notes
+    vb_text = root.get("viewBox")
+    vb = parse_viewbox(vb_text)
+    if vb_text is not None and vb is None:
+        notes.append(
+            f"ignored the viewBox {shown(vb_text)} of <svg>: it needs 4 numbers with width, height > 0"
+        )
+    dims = []
+    for key in ("width", "height"):
+        text = root.get(key)
+        got = parse_length(text) if text is not None else None
+        ok = got is not None and math.isfinite(got.value) and got.value > 0 and got.unit in (*_ABSOLUTE, "%")
+        if text is not None and not ok:
+            unit = "a positive length in px, pt, pc, mm, cm, in or %"
+            notes.append(f"ignored the {key} {shown(text)} of <svg>: it must be {unit}")
+        dims.append(text.strip() if ok and text else None)
+    size = (dims[0] or "100%", dims[1] or "100%") if any(dims) else None
+    root_style = reader.cascade.computed(root, {}, DEFAULT_FONT_SIZE)
+    reader.root_font = font_size_px(root_style.get("font-size", ""), DEFAULT_FONT_SIZE, DEFAULT_FONT_SIZE)
+    px = []
+    for i, d in enumerate(dims):
+        got = parse_length(d) if d else None
+        px.append(to_user(got, Viewport(1, 1), "x" if i == 0 else "y") if got and got.unit != "%" else None)
+    ctm = IDENTITY
+    if vb is not None:
+        vp = Viewport(vb[2], vb[3], reader.root_font, reader.root_font)
+        par = (root.get("preserveAspectRatio") or "").strip()
+        if par and par.split()[0] != "xMidYMid" and px[0] and px[1]:
+            # A non-default alignment is drawn into the viewport here: the canvas becomes the viewport.
+            ctm = viewbox_transform(vb, 0.0, 0.0, px[0], px[1], par)
+            vb = (0.0, 0.0, px[0], px[1])
+    else:
+        vp = Viewport(px[0] or 100.0, px[1] or 100.0, reader.root_font, reader.root_font)
+    ctx = Ctx(ctm=ctm, style={}, vp=vp)
+    return vb, size, ctx
+
+
+def _elements(reader: Reader) -> tuple[list[Element], Counter]:
+    """Transform the shape records into elements (one vectorised pass) and drop unusable ones."""
+    skips: Counter = Counter(reader.skips)
+    recs = [r for r in reader.records if isinstance(r, ShapeRecord) and r.path.cubics.shape[0]]
+    if not recs:
+        return [], skips
+    counts = np.fromiter((r.path.cubics.shape[0] for r in recs), dtype=np.intp, count=len(recs))
+    cubics = np.concatenate([r.path.cubics for r in recs])
+    mats = np.repeat(np.array([r.ctm for r in recs], dtype=float), counts, axis=0)
+    x, y = cubics.real, cubics.imag
+    a, b, c, d, e, f = (mats[:, i : i + 1] for i in range(6))
+    with np.errstate(invalid="ignore", over="ignore"):
+        cubics = (a * x + c * y + e) + 1j * (b * x + d * y + f)
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    with np.errstate(invalid="ignore", over="ignore"):
+        seg_ok = np.isfinite(cubics).all(axis=1) & (np.abs(cubics).max(axis=1) <= MAX_COORD)
+        bad = np.add.reduceat((~seg_ok).astype(np.intp), starts) > 0
+        first = cubics[starts, 0]
+        spread = np.abs(cubics - np.repeat(first, counts)[:, None]).max(axis=1)
+        extent = np.maximum.reduceat(spread, starts)
+        flat = ~bad & (extent <= 1e-12 * np.abs(first))
+    skips["non-finite or huge coordinates"] += int(bad.sum())
+    skips["degenerate (zero size)"] += int(flat.sum())
+    cubics.flags.writeable = False
+    ends = starts + counts
+    out = []
+    for i in np.flatnonzero(~(bad | flat)).tolist():
+        r = recs[i]
+        sub = r.path.subpaths
+        sub.flags.writeable = False
+        style = ";".join(f"{k}:{v}" for k, v in r.style.items())
+        out.append(Element(cubics[starts[i] : ends[i]], sub, r.path.closed, style, r.source, r.order))
+    return out, skips
+
+
+def _skip_messages(skips: Counter) -> list[str]:
+    return [f"skipped {n} element{'s' if n != 1 else ''}: {reason}" for reason, n in skips.items() if n > 0]
+
+
+def _kept_messages(kept: Counter) -> list[str]:
+    if not kept:
+        return []
+    parts = [f"{n} {what}" for what, n in kept.items()]
+    return ["kept as is: " + ", ".join(parts)]

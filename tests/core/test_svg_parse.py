@@ -315,7 +315,7 @@ def _fan_out(levels: int, width: int) -> str:
 
 
 HOSTILE = [
-    ("billion laughs", BILLION_LAUGHS, SvgError, "entities are not allowed"),
+    ("billion laughs", BILLION_LAUGHS, SvgError, "nested entities are not allowed"),
     ("xxe", XXE, SvgError, "entities are not allowed"),
     (
         "internal subset",
@@ -323,14 +323,12 @@ HOSTILE = [
         SvgError,
         "internal subset",
     ),
-    ("self use", svg('<use id="u" href="#u"/><rect width="1" height="1"/>'), SvgError, "cycle"),
     (
-        "use cycle",
+        "use cycle only",
         svg('<g id="a"><use href="#b"/></g><g id="b"><use xlink:href="#a"/></g>'),
         SvgError,
         "cycle",
     ),
-    ("ancestor use", svg('<g id="a"><rect width="1" height="1"/><use href="#a"/></g>'), SvgError, "cycle"),
     ("use fan-out", _fan_out(12, 10), LimitError, "more than 200,000 elements"),
     ("truncated", svg('<rect width="1" height="1"/>')[:-9], SvgError, "not an SVG"),
     ("binary junk", bytes(range(256)) * 4, SvgError, "not an SVG"),
@@ -350,13 +348,29 @@ HOSTILE = [
         "not an SVG",
     ),
     ("unknown encoding", b'<?xml version="1.0" encoding="x-nope"?><svg/>', SvgError, "not an SVG"),
-    (
-        "bad transform",
-        svg('<rect width="4" height="4" transform="rotate(foo)"/>'),
-        SvgError,
-        "cannot read SVG",
-    ),
 ]
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        '<use id="u" href="#u"/><rect width="1" height="1"/>',
+        '<g id="a"><rect width="1" height="1"/><use href="#a"/></g>',
+    ],
+    ids=["self use", "ancestor use"],
+)
+def test_use_cycles_are_skipped_with_a_warning(body):
+    """A <use> closing a reference cycle is left out (as renderers do); the rest is drawn."""
+    scene = parse_svg(svg(body))
+    assert [e.source for e in scene.elements] == ["rect[0]"]
+    assert any("reference cycle" in w for w in scene.warnings)
+
+
+def test_unreadable_transform_is_ignored_with_a_warning():
+    scene = parse_svg(svg('<rect width="4" height="4" transform="rotate(foo)"/>'))
+    (el,) = scene.elements
+    assert el.cubics[0, 0] == 0
+    assert any("unreadable transform 'rotate(foo)'" in w for w in scene.warnings)
 
 
 @pytest.mark.parametrize(("label", "data", "error", "message"), HOSTILE, ids=[h[0] for h in HOSTILE])
@@ -425,3 +439,156 @@ def test_import_of_many_paths():
     text = svg(body, 'viewBox="0 0 1000 1000"')
     scene = parse_svg(text)  # speed: tests/bench/bench_svg.py
     assert len(scene.elements) == 3000
+
+
+# ---------------------------------------------------------------------------
+# What each element draws with, paint order, definitions and content kept as is
+
+
+def test_css_rule_after_import_still_applies():
+    text = svg('<style>@import url(other.css); path { fill: red }</style><path d="M0 0 L10 0 L5 5 Z"/>')
+    scene = parse_svg(text)
+    assert style_of(scene.elements[0])["fill"] == "#ff0000"
+    assert any("@import" in w for w in scene.warnings)
+
+
+def test_empty_stroke_is_no_stroke():
+    (el,) = parse_svg(svg('<path stroke="" d="M0 0 L10 0 L5 5 Z"/>')).elements
+    assert style_of(el)["stroke"] == "none"
+
+
+def test_paint_order_numbers_elements_and_kept_content_together():
+    text = svg(
+        '<rect width="5" height="5"/><text x="1" y="9">A</text>'
+        '<image href="data:," width="2" height="2"/><circle cx="5" cy="5" r="2"/>'
+    )
+    scene = parse_svg(text)
+    assert [e.order for e in scene.elements] == [0, 3]
+    assert [v.order for v in scene.verbatim] == [1, 2]
+    assert scene.verbatim[0].what == "<text> 'A'"
+    assert "kept as is: 1 <text>, 1 <image>" in scene.warnings
+
+
+def test_kept_content_carries_inherited_style_and_transform():
+    text = svg(
+        "<style>text { font-size: 7px }</style>"
+        '<g fill="green" transform="translate(10 20)"><text x="1" y="2">hi</text></g><rect width="1" height="1"/>'
+    )
+    (v,) = parse_svg(text).verbatim
+    root = ET.fromstring(v.xml)
+    assert root.get("transform") == "matrix(1 0 0 1 10 20)"
+    assert "fill:green" in root.get("style")
+    assert "font-size:7px" in root[0].get("style")
+
+
+def test_gradients_are_rewritten_in_document_coordinates():
+    text = svg(
+        '<linearGradient id="g"><stop offset="0" stop-color="red"/><stop offset="1" stop-color="blue"/>'
+        "</linearGradient>"
+        '<rect x="10" y="10" width="20" height="10" fill="url(#g)" transform="translate(5 0)"/>'
+        '<rect x="0" y="0" width="10" height="10" fill="url(#g)"/>'
+    )
+    scene = parse_svg(text)
+    refs = [style_of(e)["fill"] for e in scene.elements]
+    assert refs[0] != refs[1] and all(r.startswith("url(#g-") for r in refs)
+    defs = ET.fromstring(f'<defs xmlns="http://www.w3.org/2000/svg">{scene.defs}</defs>')
+    ids = [g.get("id") for g in defs]
+    assert len(ids) == len(set(ids)) == 2
+    first = defs[0]
+    assert first.get("gradientUnits") == "userSpaceOnUse"
+    # objectBoundingBox of the first rect (20 x 10 at 10,10), then its translate(5 0).
+    assert first.get("gradientTransform") == "matrix(20 0 0 10 15 10)"
+
+
+def test_markers_are_expanded_into_elements():
+    """A flag whose 50 stars are marker-mid instances gives 50 star elements (plus the line)."""
+    points = " ".join(f"{10 + 10 * i},10" for i in range(52))
+    text = svg(
+        '<marker id="star" markerWidth="4" markerHeight="4" refX="2" refY="2" markerUnits="userSpaceOnUse">'
+        '<path d="M2 0 L3 4 L0 1.5 L4 1.5 L1 4 Z" fill="white"/></marker>'
+        f'<polyline points="{points}" fill="none" stroke="blue" marker-mid="url(#star)"/>',
+        'viewBox="0 0 600 20"',
+    )
+    scene = parse_svg(text)
+    stars = [e for e in scene.elements if "marker" in e.source]
+    assert len(stars) == 50
+    assert [e.order for e in scene.elements] == sorted(e.order for e in scene.elements)
+    centres = sorted(float(np.mean(e.cubics[:, 0].real)) for e in stars)
+    assert centres[0] == pytest.approx(20, abs=1.5) and centres[-1] == pytest.approx(510, abs=1.5)
+
+
+def test_nested_svg_viewport_maps_and_clips():
+    text = svg(
+        '<svg x="10" y="10" width="20" height="20" viewBox="0 0 10 10">'
+        '<rect x="0" y="0" width="10" height="10"/></svg>'
+    )
+    scene = parse_svg(text)
+    (el,) = scene.elements
+    assert el.cubics[:, 0] == pytest.approx(np.array([10 + 10j, 30 + 10j, 30 + 30j, 10 + 30j]))
+    assert style_of(el)["clip-path"].startswith("url(#viewport-")
+
+
+def test_rect_rounded_corners_and_font_relative_units():
+    text = svg('<g font-size="10"><rect x="1em" y="0" width="4em" height="2em" rx="0.5em"/></g>')
+    (el,) = parse_svg(text).elements
+    x0, y0, x1, y1 = (
+        el.cubics.real.min(),
+        el.cubics.imag.min(),
+        el.cubics.real.max(),
+        el.cubics.imag.max(),
+    )
+    assert (x0, y0, x1, y1) == pytest.approx((10, 0, 50, 20))
+    assert len(el.cubics) > 4  # rounded corners are curves
+    assert not any(np.isclose(el.cubics[:, 0], 10 + 0j))  # no sharp corner at (x, y)
+
+
+def test_stroke_widths_and_dashes_are_in_document_units():
+    text = svg(
+        '<path transform="scale(2)" d="M0 0 L10 0" stroke="black" stroke-width="3" '
+        'stroke-dasharray="1 2 3" stroke-dashoffset="1" stroke-linecap="round" stroke-linejoin="bevel"/>'
+    )
+    (el,) = parse_svg(text).elements
+    st = style_of(el)
+    assert st["stroke-width"] == "6"
+    assert st["stroke-dasharray"] == "2,4,6,2,4,6"
+    assert st["stroke-dashoffset"] == "2"
+    assert st["stroke-linecap"] == "round" and st["stroke-linejoin"] == "bevel"
+
+
+def test_clip_paths_are_rewritten_in_document_coordinates():
+    text = svg(
+        '<clipPath id="c" clipPathUnits="objectBoundingBox"><rect width="0.5" height="1"/></clipPath>'
+        '<rect x="10" y="0" width="20" height="10" clip-path="url(#c)"/>'
+    )
+    scene = parse_svg(text)
+    ref = style_of(scene.elements[0])["clip-path"]
+    defs = ET.fromstring(f'<defs xmlns="http://www.w3.org/2000/svg">{scene.defs}</defs>')
+    (clip,) = [c for c in defs if "url(#" + c.get("id") + ")" == ref]
+    c, _, _ = cubics_from_d(clip[0].get("d"))
+    assert (c.real.min(), c.real.max(), c.imag.min(), c.imag.max()) == pytest.approx((10, 20, 0, 10))
+
+
+def test_illustrator_entities_are_accepted():
+    text = (
+        '<?xml version="1.0"?><!DOCTYPE svg PUBLIC "-//W3C//DTD SVG 1.1//EN" '
+        '"http://www.w3.org/Graphics/SVG/1.1/DTD/svg11.dtd" [\n'
+        '<!ENTITY ns_svg "http://www.w3.org/2000/svg">\n<!ENTITY st0 "fill:#ff0000">\n]>'
+        '<svg xmlns="&ns_svg;" viewBox="0 0 10 10"><rect style="&st0;" width="5" height="5"/></svg>'
+    )
+    (el,) = parse_svg(text).elements
+    assert style_of(el)["fill"] == "#ff0000"
+
+
+def test_internal_subset_after_64_kib_is_still_checked():
+    text = '<?xml version="1.0"?>' + "<!-- " + "x" * 70_000 + " -->"
+    text += '<!DOCTYPE svg [<!ENTITY % p "x">]><svg xmlns="http://www.w3.org/2000/svg"/>'
+    with pytest.raises(SvgError, match="parameter entities"):
+        parse_svg(text)
+
+
+def test_names_and_ids_are_escaped_in_messages():
+    with pytest.raises(SvgError) as info:
+        parse_svg(svg(""), name="evil\nname\x1b[31m.svg")
+    assert "\n" not in str(info.value) and "\x1b" not in str(info.value)
+    scene = parse_svg(svg('<rect id="a&#10;b" width="1" height="1" transform="bad"/>'))
+    assert all("\n" not in w for w in scene.warnings)

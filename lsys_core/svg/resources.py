@@ -1,0 +1,505 @@
+"""Paint servers, clip paths and masks rewritten in document coordinates, for the scene's ``<defs>``.
+
+An element of the scene is geometry in document coordinates, so what its style refers to must be
+in document coordinates too.  Each reference is rewritten for the element that uses it: the
+element's transform (and, for ``objectBoundingBox`` units, its bounding box) is folded into a
+``gradientTransform`` / ``patternTransform`` or into the clip path's own geometry, and units
+become ``userSpaceOnUse``.  A copy is made once per distinct (resource, transform, box) and gets
+a new id, unique among all ids of the input and of the copies; everything a copy refers to is
+copied as well, so every reference in the definitions resolves.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from collections.abc import Callable
+
+import numpy as np
+
+from lsys_core.geometry.bezier import transform_cubics
+from lsys_core.geometry.paths import ArrayPath, d_from_cubics
+from lsys_core.svg.paint import Paint, split_url, unit_value
+from lsys_core.svg.tree import Tree, href_of, local_name
+from lsys_core.svg.values import (
+    IDENTITY,
+    Matrix,
+    Viewport,
+    hex_of,
+    multiply,
+    parse_color,
+    parse_length,
+    parse_transform,
+    to_user,
+)
+from lsys_core.svg.verbatim import matrix_text, style_text, subtree_markup
+
+__all__ = ["EMPTY", "Resources"]
+
+#: Returned by :meth:`Resources.clip` for a clip path that lets nothing through.
+EMPTY = "empty"
+_GRADIENTS = ("linearGradient", "radialGradient")
+_GRADIENT_ATTRS = {
+    "linearGradient": (("x1", "0%"), ("y1", "0%"), ("x2", "100%"), ("y2", "0%")),
+    "radialGradient": (("cx", "50%"), ("cy", "50%"), ("r", "50%"), ("fx", None), ("fy", None), ("fr", "0%")),
+}
+_CLIP_SHAPES = frozenset({"path", "rect", "circle", "ellipse", "line", "polyline", "polygon"})
+Box = tuple[float, float, float, float]  # x, y, width, height
+
+
+def _box_matrix(box: Box) -> Matrix:
+    return (box[2], 0.0, 0.0, box[3], box[0], box[1])
+
+
+def _f(v: float) -> str:
+    return f"{v:.10g}"
+
+
+class Resources:
+    """The definitions of one scene: rewritten paint servers, clip paths, masks and raw copies."""
+
+    def __init__(
+        self,
+        tree: Tree,
+        style_at: Callable[[ET.Element], dict[str, str]],
+        specified: Callable[[ET.Element], dict[str, str]],
+        geometry: Callable[[ET.Element, Viewport], ArrayPath | None],
+        notes: list[str],
+    ) -> None:
+        self.tree = tree
+        self.style_at = style_at
+        self.specified = specified
+        self.geometry = geometry
+        self.notes = notes
+        self.parts: list[str] = []
+        self.taken: set[str] = set(tree.ids)
+        self._cache: dict[tuple, object] = {}
+        self._raw_done: set[str] = set()
+        self._emitted_ids: set[str] = set()
+        self._busy: set[int] = set()
+        self._clip_body: dict[str, list[tuple[str, str | None]]] = {}
+
+    def markup(self) -> str:
+        """All definitions, one after another."""
+        return "\n".join(self.parts)
+
+    def new_id(self, base: str) -> str:
+        """Return a fresh id derived from ``base`` (unique among input ids and earlier copies)."""
+        stem = "".join(c if c.isalnum() or c in "-_." else "_" for c in base)[:40] or "r"
+        if not (stem[0].isalpha() or stem[0] == "_"):
+            stem = "r" + stem
+        k = 1
+        while f"{stem}-{k}" in self.taken:
+            k += 1
+        new = f"{stem}-{k}"
+        self.taken.add(new)
+        return new
+
+    def keep_id(self, el_id: str) -> bool:
+        """Whether a copied element may keep its id (only its first copy does)."""
+        if el_id in self._emitted_ids:
+            return False
+        self._emitted_ids.add(el_id)
+        return True
+
+    # -- raw copies (content kept as is refers to these in its own coordinates) -------------------
+
+    def raw(self, el_id: str) -> None:
+        """Copy the element with this id (and what it refers to) into the definitions, once."""
+        if el_id in self._raw_done:
+            return
+        self._raw_done.add(el_id)
+        el = self.tree.ids.get(el_id)
+        if el is None:
+            return
+        self.parts.append(self.content_markup(el))
+
+    def content_markup(self, el: ET.Element) -> str:
+        """Markup of an element subtree with styles baked in and its references copied."""
+        return subtree_markup(el, self.specified, self.raw, self.keep_id)
+
+    # -- paint servers --------------------------------------------------------------------------
+
+    def paint_server(self, ref: str, ctm: Matrix, bbox: Box | None, vp: Viewport) -> Paint | str:
+        """Resolve ``url(ref)`` for an element: a paint, None (paints nothing) or ``"missing"``."""
+        target = self.tree.target(ref)
+        tag = local_name(target.tag) if target is not None else None
+        if target is None or tag not in (*_GRADIENTS, "pattern"):
+            return "missing"
+        key = (id(target), ctm, bbox, vp)
+        if key in self._cache:
+            return self._cache[key]  # type: ignore[return-value]
+        if id(target) in self._busy:
+            return None
+        self._busy.add(id(target))
+        try:
+            if tag == "pattern":
+                got = self._pattern(target, ctm, bbox, vp)
+            else:
+                got = self._gradient(target, tag, ctm, bbox, vp)
+        finally:
+            self._busy.discard(id(target))
+        self._cache[key] = got
+        return got
+
+    def _chain(self, el: ET.Element, kinds: tuple[str, ...]) -> list[ET.Element] | None:
+        """The element and the ones it inherits from through ``href`` (of the given kinds).
+
+        None if a reference leads nowhere, to another kind of element or back into the chain:
+        renderers then paint nothing with it.
+        """
+        out = [el]
+        seen = {id(el)}
+        cur = el
+        while True:
+            href = href_of(cur)
+            if not href:
+                return out
+            nxt = self.tree.target(href)
+            if nxt is None or id(nxt) in seen or local_name(nxt.tag) not in kinds or len(out) >= 64:
+                return None
+            out.append(nxt)
+            seen.add(id(nxt))
+            cur = nxt
+
+    @staticmethod
+    def _attr(chain: list[ET.Element], name: str, kinds: tuple[str, ...] | None = None) -> str | None:
+        for el in chain:
+            if kinds is not None and local_name(el.tag) not in kinds:
+                continue
+            v = el.get(name)
+            if v is not None:
+                return v
+        return None
+
+    def _gradient(self, el: ET.Element, tag: str, ctm: Matrix, bbox: Box | None, vp: Viewport) -> Paint:
+        chain = self._chain(el, _GRADIENTS)
+        if chain is None:
+            return None
+        stops = self._stops(chain)
+        if not stops:
+            return None
+        if len(stops) == 1:
+            _, color, opacity = stops[0]
+            return ("color", color, opacity)
+        units = (self._attr(chain, "gradientUnits") or "objectBoundingBox").strip()
+        obb = units != "userSpaceOnUse"
+        if obb and (bbox is None or bbox[2] <= 0 or bbox[3] <= 0):
+            return None
+        gt = parse_transform(self._attr(chain, "gradientTransform")) or IDENTITY
+        m = multiply(multiply(ctm, _box_matrix(bbox)), gt) if obb and bbox else multiply(ctm, gt)
+        unit_vp = Viewport(1.0, 1.0, vp.font_size, vp.root_font_size)
+        coords: dict[str, float] = {}
+        for name, default in _GRADIENT_ATTRS[tag]:
+            text = self._attr(chain, name, (tag,))
+            if text is None:
+                if default is None:
+                    continue
+                text = default
+            got = parse_length(text)
+            if got is None or (name in ("r", "fr") and got.value < 0):
+                got = parse_length(default) if default else None
+                if got is None:
+                    continue
+            axis = (
+                "x" if name in ("x1", "x2", "cx", "fx") else "y" if name in ("y1", "y2", "cy", "fy") else "o"
+            )
+            coords[name] = to_user(got, unit_vp if obb else vp, axis)
+        if tag == "radialGradient":
+            coords.setdefault("fx", coords["cx"])
+            coords.setdefault("fy", coords["cy"])
+            if coords.get("r", 0) <= 0:
+                return None  # a radial gradient of radius 0 paints nothing (as renderers draw it)
+        spread = (self._attr(chain, "spreadMethod") or "pad").strip()
+        new = self.new_id(el.get("id") or "gradient")
+        attrs = " ".join(f'{k}="{_f(v)}"' for k, v in coords.items())
+        spread_attr = f' spreadMethod="{spread}"' if spread in ("reflect", "repeat") else ""
+        body = "".join(
+            f'<stop offset="{_f(o)}" stop-color="{c}"' + (f' stop-opacity="{_f(a)}"' if a < 1 else "") + "/>"
+            for o, c, a in stops
+        )
+        self.parts.append(
+            f'<{tag} id="{new}" gradientUnits="userSpaceOnUse" {attrs} '
+            f'gradientTransform="{matrix_text(m)}"{spread_attr}>{body}</{tag}>'
+        )
+        return ("url", "#" + new, 1.0)
+
+    def _stops(self, chain: list[ET.Element]) -> list[tuple[float, str, float]]:
+        """The stops of the first gradient in the chain that has any: (offset, colour, opacity)."""
+        for el in chain:
+            stops = [c for c in el if local_name(c.tag) == "stop"]
+            if not stops:
+                continue
+            out = []
+            last = 0.0
+            for s in stops:
+                off_text = (s.get("offset") or "0").strip()
+                off = unit_value(off_text, 0.0)
+                off = max(off, last)
+                last = off
+                st = self.style_at(s)
+                rgba = parse_color(st.get("stop-color", "black"), parse_color(st.get("color", "black")))
+                rgba = rgba or (0.0, 0.0, 0.0, 1.0)
+                opacity = unit_value(st.get("stop-opacity"), 1.0) * rgba[3]
+                out.append((off, hex_of(rgba), opacity))
+            return out
+        return []
+
+    def _pattern(self, el: ET.Element, ctm: Matrix, bbox: Box | None, vp: Viewport) -> Paint:
+        chain = self._chain(el, ("pattern",))
+        if chain is None:
+            return None
+        units = (self._attr(chain, "patternUnits") or "objectBoundingBox").strip()
+        content_units = (self._attr(chain, "patternContentUnits") or "userSpaceOnUse").strip()
+        obb = units != "userSpaceOnUse"
+        if (obb or content_units == "objectBoundingBox") and (bbox is None or bbox[2] <= 0 or bbox[3] <= 0):
+            return None
+        unit_vp = Viewport(1.0, 1.0, vp.font_size, vp.root_font_size)
+        tile = []
+        for name, axis in (("x", "x"), ("y", "y"), ("width", "x"), ("height", "y")):
+            got = parse_length(self._attr(chain, name) or "0")
+            tile.append(0.0 if got is None else to_user(got, unit_vp if obb else vp, axis))
+        if obb and bbox:
+            tile = [
+                bbox[0] + tile[0] * bbox[2],
+                bbox[1] + tile[1] * bbox[3],
+                tile[2] * bbox[2],
+                tile[3] * bbox[3],
+            ]
+        if tile[2] <= 0 or tile[3] <= 0:
+            return None
+        content_el = next((c for c in chain if any(isinstance(k.tag, str) for k in c)), None)
+        if content_el is None:
+            return None
+        pt = parse_transform(self._attr(chain, "patternTransform")) or IDENTITY
+        m = multiply(ctm, pt)
+        viewbox = self._attr(chain, "viewBox")
+        par = self._attr(chain, "preserveAspectRatio")
+        inner = "".join(self.content_markup(c) for c in content_el if isinstance(c.tag, str))
+        if viewbox is None and content_units == "objectBoundingBox" and bbox:
+            inner = f'<g transform="matrix({_f(bbox[2])} 0 0 {_f(bbox[3])} 0 0)">{inner}</g>'
+        # Content inherits from the pattern element, not from the element it paints.
+        inherited = {k: v for k, v in self.style_at(content_el).items() if k != "display"}
+        if inherited:
+            inner = f'<g style="{_esc(style_text(inherited))}">{inner}</g>'
+        new = self.new_id(el.get("id") or "pattern")
+        extra = (f' viewBox="{_esc(viewbox)}"' if viewbox else "") + (
+            f' preserveAspectRatio="{_esc(par)}"' if par else ""
+        )
+        self.parts.append(
+            f'<pattern id="{new}" patternUnits="userSpaceOnUse" x="{_f(tile[0])}" y="{_f(tile[1])}" '
+            f'width="{_f(tile[2])}" height="{_f(tile[3])}" patternTransform="{matrix_text(m)}"{extra}>'
+            f"{inner}</pattern>"
+        )
+        return ("url", "#" + new, 1.0)
+
+    # -- clip paths and masks -------------------------------------------------------------------
+
+    def clip(self, value: str | None, ctm: Matrix, bbox: Box | None, vp: Viewport) -> str | None:
+        """Rewrite a ``clip-path`` value for an element: an id, None (no clipping) or :data:`EMPTY`."""
+        if value is None or value.strip().lower() == "none":
+            return None
+        ref, _ = split_url(value)
+        target = self.tree.target(ref)
+        if target is None or local_name(target.tag) != "clipPath":
+            return None
+        key = ("clip", id(target), ctm, bbox)
+        if key in self._cache:
+            return self._cache[key]  # type: ignore[return-value]
+        if id(target) in self._busy:  # a clip path that clips itself: invalid, nothing is drawn
+            return EMPTY
+        self._busy.add(id(target))
+        try:
+            got = self._clip(target, ctm, bbox, vp)
+        finally:
+            self._busy.discard(id(target))
+        self._cache[key] = got
+        return got
+
+    def _clip(self, el: ET.Element, ctm: Matrix, bbox: Box | None, vp: Viewport) -> str | None:
+        obb = (el.get("clipPathUnits") or "").strip() == "objectBoundingBox"
+        if obb and (bbox is None or bbox[2] <= 0 or bbox[3] <= 0):
+            return EMPTY
+        base = multiply(ctm, _box_matrix(bbox)) if obb and bbox else ctm
+        base = multiply(base, parse_transform(el.get("transform")) or IDENTITY)
+        pieces: list[tuple[str, str | None]] = []
+        for child in el:
+            piece = self._clip_piece(child, base, vp)
+            if piece is not None:
+                pieces.append(piece)
+        own = self.clip(self.style_at(el).get("clip-path"), base, bbox, vp)
+        if own == EMPTY or not pieces:
+            return EMPTY
+        return self._add_clip(el.get("id") or "clip", pieces, own)
+
+    def _clip_piece(self, child: ET.Element, base: Matrix, vp: Viewport) -> tuple[str, str | None] | None:
+        """One child of a clip path in document coordinates: its start tag and own clip; None if it adds nothing."""
+        tag = local_name(child.tag)
+        if tag is None:
+            return None
+        style = self.style_at(child)
+        source = child
+        m = multiply(base, parse_transform(style.get("transform")) or IDENTITY)
+        if tag == "use":
+            target = self.tree.target(href_of(child))
+            if target is None or local_name(target.tag) not in (*_CLIP_SHAPES, "text"):
+                return None
+            m = multiply(
+                m, (1.0, 0.0, 0.0, 1.0, _length(child.get("x"), vp, "x"), _length(child.get("y"), vp, "y"))
+            )
+            source, tag = target, local_name(target.tag)
+            target_style = self.specified(target)
+            m = multiply(m, parse_transform(target_style.get("transform")) or IDENTITY)
+            style = {**style, **target_style}
+        if style.get("display", "").lower() == "none" or style.get("visibility", "visible") != "visible":
+            return None
+        own = self.clip(style.get("clip-path"), m, None, vp)
+        if own == EMPTY:
+            return None
+        rule = style.get("clip-rule", "nonzero")
+        if tag in _CLIP_SHAPES:
+            geom = self.geometry(source, vp)
+            if geom is None or geom.cubics.shape[0] == 0:
+                return None
+            cub = transform_cubics(geom.cubics, m)
+            if not np.isfinite(cub).all():
+                return None
+            d = d_from_cubics(cub, geom.subpaths, geom.closed)
+            return f'<path d="{d}" clip-rule="{rule}"/>', own
+        if tag == "text":
+            decls = {k: v for k, v in self.specified(source).items() if k not in ("transform", "clip-path")}
+            markup = subtree_markup(
+                source, lambda e: decls if e is source else self.specified(e), self.raw, self.keep_id
+            )
+            head_end = markup.index(">")
+            if markup[head_end - 1] == "/":
+                head_end -= 1
+            # The text's own transform is part of m: replace it.
+            head = _drop_attr(markup[:head_end], "transform") + f' transform="{matrix_text(m)}"'
+            return head + markup[head_end:], own
+        return None  # not a valid child of a clip path
+
+    def _add_clip(self, base: str, pieces: list[tuple[str, str | None]], outer: str | None = None) -> str:
+        """Write a clip path of ``pieces`` (each clipped by its own clip and by ``outer``); return its id.
+
+        Intersections are written as clip paths on the pieces, which renderers agree on.
+        """
+        stored = [(markup, self.intersect(own, outer)) for markup, own in pieces]
+        new = self.new_id(base)
+        self._clip_body[new] = stored
+        body = "".join(_with_clip(markup, clip) for markup, clip in stored)
+        self.parts.append(f'<clipPath id="{new}" clipPathUnits="userSpaceOnUse">{body}</clipPath>')
+        return new
+
+    def intersect(self, inner: str | None, outer: str | None) -> str | None:
+        """Return a clip path letting through what both let through."""
+        if inner is None or outer is None or inner == outer:
+            return inner or outer
+        if EMPTY in (inner, outer):
+            return EMPTY
+        key = ("and", inner, outer)
+        if key not in self._cache:
+            self._cache[key] = self._add_clip("clip", self._clip_body[inner], outer)
+        return self._cache[key]  # type: ignore[return-value]
+
+    def mask(self, value: str | None, ctm: Matrix, bbox: Box | None, vp: Viewport) -> str | None:
+        """Rewrite a ``mask`` value for an element: an id, None (no mask) or :data:`EMPTY`."""
+        if value is None or value.strip().lower() == "none":
+            return None
+        ref, _ = split_url(value)
+        target = self.tree.target(ref)
+        if target is None or local_name(target.tag) != "mask":
+            return None
+        key = ("mask", id(target), ctm, bbox)
+        if key in self._cache:
+            return self._cache[key]  # type: ignore[return-value]
+        if id(target) in self._busy:
+            return EMPTY
+        self._busy.add(id(target))
+        try:
+            got = self._mask(target, ctm, bbox, vp)
+        finally:
+            self._busy.discard(id(target))
+        self._cache[key] = got
+        return got
+
+    def _mask(self, el: ET.Element, ctm: Matrix, bbox: Box | None, vp: Viewport) -> str | None:
+        obb = (el.get("maskUnits") or "objectBoundingBox").strip() != "userSpaceOnUse"
+        content_obb = (el.get("maskContentUnits") or "").strip() == "objectBoundingBox"
+        if (obb or content_obb) and (bbox is None or bbox[2] <= 0 or bbox[3] <= 0):
+            return EMPTY
+        unit_vp = Viewport(1.0, 1.0, vp.font_size, vp.root_font_size)
+        region = []
+        for name, axis, default in (
+            ("x", "x", "-10%"),
+            ("y", "y", "-10%"),
+            ("width", "x", "120%"),
+            ("height", "y", "120%"),
+        ):
+            got = parse_length(el.get(name) or default) or parse_length(default)
+            region.append(to_user(got, unit_vp if obb else vp, axis))  # type: ignore[arg-type]
+        if obb and bbox:
+            region = [
+                bbox[0] + region[0] * bbox[2],
+                bbox[1] + region[1] * bbox[3],
+                region[2] * bbox[2],
+                region[3] * bbox[3],
+            ]
+        if region[2] <= 0 or region[3] <= 0:
+            return EMPTY
+        corners = [complex(region[0] + dx, region[1] + dy) for dx in (0, region[2]) for dy in (0, region[3])]
+        a, b, c, d, e, f = ctm
+        pts = [complex(a * p.real + c * p.imag + e, b * p.real + d * p.imag + f) for p in corners]
+        x0, x1 = min(p.real for p in pts), max(p.real for p in pts)
+        y0, y1 = min(p.imag for p in pts), max(p.imag for p in pts)
+        content_m = multiply(ctm, _box_matrix(bbox)) if content_obb and bbox else ctm
+        inner = "".join(self.content_markup(ch) for ch in el if isinstance(ch.tag, str))
+        inherited = self.style_at(el)
+        style = f' style="{_esc(style_text(inherited))}"' if inherited else ""
+        kind = self.specified(el).get("mask-type") or el.get("mask-type")
+        kind_attr = f' mask-type="{_esc(kind)}"' if kind else ""
+        new = self.new_id(el.get("id") or "mask")
+        self.parts.append(
+            f'<mask id="{new}" maskUnits="userSpaceOnUse" x="{_f(x0)}" y="{_f(y0)}" '
+            f'width="{_f(x1 - x0)}" height="{_f(y1 - y0)}"{kind_attr}>'
+            f'<g transform="{matrix_text(content_m)}"{style}>{inner}</g></mask>'
+        )
+        return new
+
+    def clip_rect(self, corners: list[complex]) -> str:
+        """A clip path of a quadrilateral given in document coordinates (viewports, markers)."""
+        key = ("rect", tuple(corners))
+        if key in self._cache:
+            return self._cache[key]  # type: ignore[return-value]
+        d = "M" + " L".join(f"{_f(p.real)} {_f(p.imag)}" for p in corners) + " Z"
+        new = self._add_clip("viewport", [(f'<path d="{d}"/>', None)])
+        self._cache[key] = new
+        return new
+
+
+def _esc(text: str) -> str:
+    return text.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;")
+
+
+def _length(text: str | None, vp: Viewport, axis: str) -> float:
+    got = parse_length(text) if text is not None else None
+    return 0.0 if got is None else to_user(got, vp, axis)
+
+
+def _drop_attr(head: str, name: str) -> str:
+    """Remove one attribute from a start tag written by ElementTree (values are double-quoted)."""
+    key = f' {name}="'
+    i = head.find(key)
+    if i < 0:
+        return head
+    j = head.index('"', i + len(key))
+    return head[:i] + head[j + 1 :]
+
+
+def _with_clip(markup: str, clip: str | None) -> str:
+    """Add a clip path to the start tag of a clip piece."""
+    if not clip:
+        return markup
+    end = markup.index(">")
+    if markup[end - 1] == "/":
+        end -= 1
+    return markup[:end] + f' clip-path="url(#{clip})"' + markup[end:]

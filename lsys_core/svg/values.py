@@ -1,0 +1,384 @@
+"""SVG attribute values: colours, lengths and units, transforms, viewBox and preserveAspectRatio.
+
+Every reader here is a small scanner over the text (or the vectorised number lexer of
+:mod:`lsys_core.geometry.numbers`); none uses a backtracking regular expression, so the work is
+linear in the length of the value.  Readers return None for a value they cannot read; the caller
+decides what SVG does then (ignore the attribute, or not draw the element).
+"""
+
+from __future__ import annotations
+
+import colorsys
+import math
+from typing import NamedTuple
+
+from lsys_core.geometry.numbers import numbers_from_text
+from lsys_core.svg.colors import NAMED_COLORS
+
+__all__ = [
+    "IDENTITY",
+    "Length",
+    "Matrix",
+    "Viewport",
+    "invert",
+    "multiply",
+    "parse_color",
+    "parse_length",
+    "parse_number",
+    "parse_numbers",
+    "parse_transform",
+    "parse_viewbox",
+    "viewbox_transform",
+]
+
+Matrix = tuple[float, float, float, float, float, float]
+IDENTITY: Matrix = (1.0, 0.0, 0.0, 1.0, 0.0, 0.0)
+
+#: User units (px) per unit; font-relative and viewport-relative units are resolved by the caller.
+ABSOLUTE_UNITS = {"": 1.0, "px": 1.0, "pt": 96 / 72, "pc": 16.0, "mm": 96 / 25.4, "cm": 96 / 2.54}
+ABSOLUTE_UNITS |= {"in": 96.0, "q": 96 / 101.6}
+RELATIVE_UNITS = frozenset({"%", "em", "ex", "rem", "ch", "vw", "vh", "vmin", "vmax"})
+
+
+class Length(NamedTuple):
+    """A number with its unit (lower case; ``""`` for a plain number)."""
+
+    value: float
+    unit: str
+
+
+class Viewport(NamedTuple):
+    """What relative lengths resolve against: the viewport size and the font sizes (user units)."""
+
+    width: float
+    height: float
+    font_size: float = 16.0
+    root_font_size: float = 16.0
+
+    @property
+    def diagonal(self) -> float:
+        """The reference length of percentages that are neither horizontal nor vertical."""
+        return math.sqrt((self.width**2 + self.height**2) / 2.0)
+
+
+def parse_number(text: str | None) -> float | None:
+    """Read one finite number (surrounding white space allowed), or None."""
+    if text is None:
+        return None
+    values, error = numbers_from_text(text.strip())
+    if error >= 0 or values.size != 1 or not math.isfinite(values[0]):
+        return None
+    return float(values[0])
+
+
+def parse_numbers(text: str | None) -> list[float] | None:
+    """Read a list of numbers separated by white space and/or commas, or None if malformed."""
+    if text is None:
+        return None
+    values, error = numbers_from_text(text)
+    if error >= 0:
+        return None
+    return values.tolist()
+
+
+def _split_unit(text: str) -> tuple[str, str]:
+    """Split ``"12.5px"`` into ``("12.5", "px")`` (the unit is the trailing letters or ``%``)."""
+    t = text.strip()
+    if t.endswith("%"):
+        return t[:-1], "%"
+    i = len(t)
+    while i > 0 and t[i - 1].isalpha():
+        i -= 1
+    unit = t[i:].lower()
+    if unit in ("e",):  # "1e" is a malformed number, not a unit
+        return t, ""
+    return t[:i], unit
+
+
+def parse_length(text: str | None) -> Length | None:
+    """Read a length such as ``12``, ``1.5em``, ``50%`` or ``3mm``; None if malformed."""
+    if text is None:
+        return None
+    number, unit = _split_unit(text)
+    if unit not in ABSOLUTE_UNITS and unit not in RELATIVE_UNITS:
+        return None
+    v = parse_number(number)
+    if v is None:
+        return None
+    return Length(v, unit)
+
+
+def to_user(length: Length, vp: Viewport, axis: str = "o") -> float:
+    """Convert a length to user units; ``axis`` ``x``/``y``/``o`` says what a percentage refers to."""
+    v, unit = length
+    if unit in ABSOLUTE_UNITS:
+        return v * ABSOLUTE_UNITS[unit]
+    if unit == "%":
+        ref = vp.width if axis == "x" else vp.height if axis == "y" else vp.diagonal
+        return v * ref / 100.0
+    if unit == "em":
+        return v * vp.font_size
+    if unit in ("ex", "ch"):
+        return v * vp.font_size / 2.0
+    if unit == "rem":
+        return v * vp.root_font_size
+    if unit == "vw":
+        return v * vp.width / 100.0
+    if unit == "vh":
+        return v * vp.height / 100.0
+    if unit == "vmin":
+        return v * min(vp.width, vp.height) / 100.0
+    return v * max(vp.width, vp.height) / 100.0  # vmax
+
+
+# ---------------------------------------------------------------------------
+# Colours
+
+
+def parse_color(text: str, current: tuple[float, float, float, float] | None = None):
+    """Read a CSS colour into ``(r, g, b, a)`` with components in [0, 1]; None if it is not one.
+
+    Accepts ``#rgb``, ``#rgba``, ``#rrggbb``, ``#rrggbbaa``, ``rgb()``/``rgba()`` (numbers or
+    percentages, commas or spaces, ``/ alpha``), ``hsl()``/``hsla()``, the named colours,
+    ``transparent`` and ``currentColor`` (``current``, black if not given).
+    """
+    t = text.strip()
+    low = t.lower()
+    if low.startswith("#"):
+        return _hex_color(low[1:])
+    if low == "currentcolor":
+        return current if current is not None else (0.0, 0.0, 0.0, 1.0)
+    if low == "transparent":
+        return (0.0, 0.0, 0.0, 0.0)
+    if low in NAMED_COLORS:
+        r, g, b = NAMED_COLORS[low]
+        return (r / 255.0, g / 255.0, b / 255.0, 1.0)
+    open_at = low.find("(")
+    if open_at < 0 or not low.endswith(")"):
+        return None
+    func = low[:open_at].strip()
+    inner = low[open_at + 1 : -1]
+    if func in ("rgb", "rgba"):
+        return _functional(inner, rgb=True)
+    if func in ("hsl", "hsla"):
+        return _functional(inner, rgb=False)
+    return None
+
+
+def _hex_color(h: str):
+    if not all(c in "0123456789abcdef" for c in h):
+        return None
+    if len(h) in (3, 4):
+        vals = [int(c * 2, 16) for c in h]
+    elif len(h) in (6, 8):
+        vals = [int(h[i : i + 2], 16) for i in range(0, len(h), 2)]
+    else:
+        return None
+    if len(vals) == 3:
+        vals.append(255)
+    return (vals[0] / 255.0, vals[1] / 255.0, vals[2] / 255.0, vals[3] / 255.0)
+
+
+def _component(text: str) -> tuple[float, bool] | None:
+    """Read a number or percentage; return (value, is_percentage)."""
+    t = text.strip()
+    pct = t.endswith("%")
+    v = parse_number(t[:-1] if pct else t)
+    return None if v is None else (v, pct)
+
+
+def _functional(inner: str, rgb: bool):
+    """Read the arguments of ``rgb()``/``hsl()`` (legacy commas or modern spaces and ``/``)."""
+    alpha_text = None
+    if "/" in inner:
+        inner, _, alpha_text = inner.partition("/")
+        parts = inner.split()
+    elif "," in inner:
+        parts = [p for p in inner.split(",")]
+        if len(parts) == 4:
+            alpha_text = parts.pop()
+    else:
+        parts = inner.split()
+    if len(parts) != 3:
+        return None
+    comps = [_component(p.removesuffix("deg") if i == 0 and not rgb else p) for i, p in enumerate(parts)]
+    if any(c is None for c in comps):
+        return None
+    alpha = 1.0
+    if alpha_text is not None:
+        a = _component(alpha_text)
+        if a is None:
+            return None
+        alpha = a[0] / 100.0 if a[1] else a[0]
+    alpha = min(max(alpha, 0.0), 1.0)
+    if rgb:
+        out = [(v * 2.55 if pct else v) for v, pct in comps]  # type: ignore[misc]
+        r, g, b = (min(max(round(x), 0), 255) / 255.0 for x in out)
+        return (r, g, b, alpha)
+    (h, _), (s, _), (l, _) = comps  # type: ignore[misc]
+    s = min(max(s / 100.0, 0.0), 1.0)
+    l = min(max(l / 100.0, 0.0), 1.0)
+    r, g, b = colorsys.hls_to_rgb((h % 360.0) / 360.0, l, s)
+    return (round(r * 255) / 255.0, round(g * 255) / 255.0, round(b * 255) / 255.0, alpha)
+
+
+def hex_of(color: tuple[float, float, float, float]) -> str:
+    """Write the opaque part of a colour as ``#rrggbb``."""
+    r, g, b = (min(max(round(c * 255), 0), 255) for c in color[:3])
+    return f"#{r:02x}{g:02x}{b:02x}"
+
+
+# ---------------------------------------------------------------------------
+# Transforms and viewports
+
+
+def multiply(m: Matrix, n: Matrix) -> Matrix:
+    """Return the affine product ``m @ n`` (``n`` applied first)."""
+    a, b, c, d, e, f = m
+    a2, b2, c2, d2, e2, f2 = n
+    return (
+        a * a2 + c * b2,
+        b * a2 + d * b2,
+        a * c2 + c * d2,
+        b * c2 + d * d2,
+        a * e2 + c * f2 + e,
+        b * e2 + d * f2 + f,
+    )
+
+
+def invert(m: Matrix) -> Matrix | None:
+    """Return the inverse of an affine matrix, or None if it is singular."""
+    a, b, c, d, e, f = m
+    det = a * d - b * c
+    if det == 0 or not math.isfinite(det):
+        return None
+    ia, ib, ic, id_ = d / det, -b / det, -c / det, a / det
+    return (ia, ib, ic, id_, -(ia * e + ic * f), -(ib * e + id_ * f))
+
+
+_ARITY = {
+    "matrix": (6,),
+    "translate": (1, 2),
+    "scale": (1, 2),
+    "rotate": (1, 3),
+    "skewx": (1,),
+    "skewy": (1,),
+}
+_ANGLE_UNITS = {"deg": 1.0, "rad": 180.0 / math.pi, "grad": 0.9, "turn": 360.0}
+
+
+def parse_transform(text: str | None, css: bool = False) -> Matrix | None:
+    """Read a transform list (``translate(10 20) rotate(45)``); None if malformed.
+
+    ``css`` accepts the CSS property syntax as well (``translate(10px, 20px)``, ``rotate(45deg)``).
+    An empty text or ``none`` is the identity.
+    """
+    if text is None:
+        return None
+    t = text.strip()
+    if not t or t.lower() == "none":
+        return IDENTITY
+    m = IDENTITY
+    i, n = 0, len(t)
+    while True:
+        while i < n and (t[i].isspace() or t[i] == ","):
+            i += 1
+        if i >= n:
+            return m
+        j = i
+        while j < n and t[j].isalpha():
+            j += 1
+        name = t[i:j].lower()
+        k = j
+        while k < n and t[k].isspace():
+            k += 1
+        if name not in _ARITY or k >= n or t[k] != "(":
+            return None
+        close = t.find(")", k)
+        if close < 0:
+            return None
+        args = _transform_args(t[k + 1 : close], name, css)
+        if args is None or len(args) not in _ARITY[name]:
+            return None
+        m = multiply(m, _one_transform(name, args))
+        i = close + 1
+
+
+def _transform_args(inner: str, name: str, css: bool) -> list[float] | None:
+    """Read the arguments of one transform function (CSS units stripped when allowed)."""
+    if not css:
+        return parse_numbers(inner)
+    out = []
+    for part in inner.replace(",", " ").split():
+        number, unit = _split_unit(part)
+        v = parse_number(number)
+        if v is None:
+            return None
+        if name in ("rotate", "skewx", "skewy") and unit:
+            if unit not in _ANGLE_UNITS:
+                return None
+            v *= _ANGLE_UNITS[unit]
+        elif unit not in ("", "px"):
+            return None
+        out.append(v)
+    return out
+
+
+def _one_transform(name: str, a: list[float]) -> Matrix:
+    if name == "matrix":
+        return (a[0], a[1], a[2], a[3], a[4], a[5])
+    if name == "translate":
+        return (1.0, 0.0, 0.0, 1.0, a[0], a[1] if len(a) > 1 else 0.0)
+    if name == "scale":
+        return (a[0], 0.0, 0.0, a[1] if len(a) > 1 else a[0], 0.0, 0.0)
+    if name == "rotate":
+        r = math.radians(a[0])
+        c, s = math.cos(r), math.sin(r)
+        rot = (c, s, -s, c, 0.0, 0.0)
+        if len(a) == 3:
+            cx, cy = a[1], a[2]
+            return multiply(multiply((1.0, 0.0, 0.0, 1.0, cx, cy), rot), (1.0, 0.0, 0.0, 1.0, -cx, -cy))
+        return rot
+    if name == "skewx":
+        return (1.0, 0.0, math.tan(math.radians(a[0])), 1.0, 0.0, 0.0)
+    return (1.0, math.tan(math.radians(a[0])), 0.0, 1.0, 0.0, 0.0)  # skewY
+
+
+def parse_viewbox(text: str | None) -> tuple[float, float, float, float] | None:
+    """Read a ``viewBox``: four finite numbers with positive width and height; None otherwise."""
+    vals = parse_numbers(text) if text else None
+    if vals is None or len(vals) != 4 or not all(math.isfinite(v) for v in vals):
+        return None
+    if vals[2] <= 0 or vals[3] <= 0:
+        return None
+    return (vals[0], vals[1], vals[2], vals[3])
+
+
+def viewbox_transform(
+    viewbox: tuple[float, float, float, float], x: float, y: float, w: float, h: float, par: str | None
+) -> Matrix:
+    """Return the matrix mapping a viewBox into the viewport ``(x, y, w, h)`` (preserveAspectRatio)."""
+    vx, vy, vw, vh = viewbox
+    words = (par or "").split()
+    if words and words[0] == "defer":
+        words = words[1:]
+    align = words[0] if words else "xMidYMid"
+    slice_ = len(words) > 1 and words[1] == "slice"
+    sx, sy = w / vw, h / vh
+    if align == "none":
+        return (sx, 0.0, 0.0, sy, x - vx * sx, y - vy * sy)
+    s = max(sx, sy) if slice_ else min(sx, sy)
+    tx, ty = x - vx * s, y - vy * s
+    if len(align) == 8 and align[0] == "x" and align[4] == "Y":
+        ax, ay = align[1:4], align[5:8]
+    else:
+        ax, ay = "Mid", "Mid"
+    if ax == "Mid":
+        tx += (w - vw * s) / 2
+    elif ax == "Max":
+        tx += w - vw * s
+    if ay == "Mid":
+        ty += (h - vh * s) / 2
+    elif ay == "Max":
+        ty += h - vh * s
+    return (s, 0.0, 0.0, s, tx, ty)

@@ -1,0 +1,487 @@
+"""The rendering walk: every element of the document, in paint order, into scene records.
+
+:class:`Reader` visits the tree as a renderer would: the cascade gives each element its style,
+transforms and viewports (nested ``<svg>``, ``<symbol>`` through ``<use>``, markers) compose into
+one matrix per element, and each drawable shape becomes a :class:`ShapeRecord` (geometry in its
+own coordinates, the matrix, and what it draws with), numbered in paint order.  Content that is
+not geometry -- text, images, foreign objects, unknown elements, anything under a filter -- becomes
+a :class:`VerbatimRecord`, a self-contained copy in document coordinates at its place in the
+order.  Group effects (opacity, clip path, mask) are applied to the records a group produced once
+its content is known.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from collections import Counter
+from dataclasses import dataclass, field, replace
+
+from lsys_core.errors import LimitError
+from lsys_core.geometry.paths import ArrayPath
+from lsys_core.svg import group_effects, markers
+from lsys_core.svg.css import StyleSheet
+from lsys_core.svg.paint import (
+    anisotropy,
+    paint_declarations,
+    parse_paint,
+    scale_of,
+    stroke_declarations,
+    unit_value,
+)
+from lsys_core.svg.pathcache import DEFAULT_MAX_SEGMENTS, PathCache
+from lsys_core.svg.resources import EMPTY, Resources
+from lsys_core.svg.shapes import Geometry, KeepAsIs, shape_geometry, tight_bbox
+from lsys_core.svg.style import DEFAULT_FONT_SIZE, Cascade
+from lsys_core.svg.tree import Tree, describe, href_of, local_name, shown
+from lsys_core.svg.values import (
+    IDENTITY,
+    Matrix,
+    Viewport,
+    multiply,
+    parse_length,
+    parse_transform,
+    parse_viewbox,
+    to_user,
+    viewbox_transform,
+)
+from lsys_core.svg.verbatim import inherited_declarations, wrap
+
+__all__ = ["Ctx", "Reader", "ShapeRecord", "VerbatimRecord"]
+
+SHAPES = frozenset({"path", "rect", "circle", "ellipse", "line", "polyline", "polygon"})
+_MARKABLE = frozenset({"path", "line", "polyline", "polygon"})
+_CONTAINERS = frozenset({"g", "a", "switch", "svg"})
+#: Elements that draw nothing where they stand.
+_NOT_DRAWN = frozenset(
+    {
+        "defs", "clipPath", "mask", "marker", "pattern", "symbol", "linearGradient", "radialGradient",
+        "filter", "style", "script", "title", "desc", "metadata", "font", "font-face", "cursor", "view",
+        "stop", "color-profile",
+    }
+)  # fmt: skip
+_ANIMATION = frozenset({"animate", "animateMotion", "animateTransform", "animateColor", "set"})
+#: Content kept as is (not geometry to infer rules from).
+_VERBATIM = frozenset({"text", "image", "foreignObject"})
+
+
+@dataclass
+class ShapeRecord:
+    """A drawable shape: geometry in its own coordinates, its matrix to document coordinates."""
+
+    path: ArrayPath
+    ctm: Matrix
+    style: dict[str, str]
+    source: str
+    order: int
+
+
+@dataclass
+class VerbatimRecord:
+    """Content kept as is: markup in document coordinates."""
+
+    xml: str
+    what: str
+    order: int
+
+
+@dataclass(frozen=True)
+class Ctx:
+    """What an element inherits from where it is drawn."""
+
+    ctm: Matrix
+    style: dict[str, str]
+    vp: Viewport
+    depth: int = 0
+    uses: tuple[int, ...] = ()
+    chain: str = ""
+    context: dict | None = None
+
+
+@dataclass
+class Reader:
+    """Walks a parsed document into records (see the module docstring)."""
+
+    tree: Tree
+    name: str
+    max_elements: int
+    max_depth: int
+    records: list[ShapeRecord | VerbatimRecord] = field(default_factory=list)
+    skips: Counter = field(default_factory=Counter)
+    kept: Counter = field(default_factory=Counter)
+    notes: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        sheet = StyleSheet()
+        for el in self.tree.root.iter():
+            if local_name(el.tag) == "style":  # whatever its type says, as renderers read it
+                sheet.add("".join(el.itertext()))
+        self.notes.extend(sheet.notes)
+        self.cascade = Cascade(self.tree, sheet)
+        self.paths = PathCache(self.tree, self.name)
+        self.segments = 0
+        self.resources = Resources(
+            self.tree, self.style_at, self.cascade.specified, self._clip_geometry, self.notes
+        )
+        self._style_cache: dict[int, dict[str, str]] = {}
+        self._names = _source_names(self.tree)
+        self.order = 0
+        self.root_font = DEFAULT_FONT_SIZE
+
+    # -- styles ---------------------------------------------------------------------------------
+
+    def style_at(self, el: ET.Element) -> dict[str, str]:
+        """The computed style of an element where it stands in the document (cached)."""
+        key = id(el)
+        got = self._style_cache.get(key)
+        if got is None:
+            chain = [el, *self.tree.ancestors(el)]
+            style: dict[str, str] = {}
+            for node in reversed(chain):
+                cached = self._style_cache.get(id(node))
+                style = cached if cached is not None else self.cascade.computed(node, style, self.root_font)
+                self._style_cache[id(node)] = style
+            got = style
+        return got
+
+    def _clip_geometry(self, el: ET.Element, vp: Viewport) -> ArrayPath | None:
+        try:
+            geom, _ = shape_geometry(el, local_name(el.tag) or "", vp, self.paths.get)
+        except KeepAsIs:
+            return None
+        return None if geom is None else geom.path
+
+    # -- records --------------------------------------------------------------------------------
+
+    def _next_order(self) -> int:
+        if len(self.records) >= self.max_elements:
+            raise LimitError(f"{self.name} draws more than {self.max_elements:,} elements")
+        self.order += 1
+        return self.order - 1
+
+    def keep_as_is(self, el: ET.Element, ctx: Ctx, why: str | None = None) -> None:
+        """Record an element (and its content) as markup in document coordinates."""
+        tag = local_name(el.tag) or "?"
+        inner = self.resources.content_markup(el)
+        xml = wrap(inner, ctx.ctm, inherited_declarations(ctx.style))
+        what = describe(el, tag)
+        if tag == "text":
+            text = " ".join("".join(el.itertext()).split())
+            what = f"<text> {shown(text, 30)}" if text else what
+        self.records.append(VerbatimRecord(xml, what + (f" ({why})" if why else ""), self._next_order()))
+        self.kept[f"<{tag}>" + (f" ({why})" if why else "")] += 1
+
+    # -- the walk -------------------------------------------------------------------------------
+
+    def walk(self, el: ET.Element, ctx: Ctx) -> None:
+        """Draw one element (and its content) in context."""
+        tag = local_name(el.tag)
+        if tag is None or tag in _NOT_DRAWN:
+            return
+        if tag in _ANIMATION:
+            self.skips["animation (not kept: the drawing is static)"] += 1
+            return
+        if ctx.depth > self.max_depth:
+            raise LimitError(f"{self.name}: elements are nested more than {self.max_depth} levels deep")
+        style = self.cascade.computed(el, ctx.style, self.root_font)
+        if style.get("display", "inline").strip().lower() == "none":
+            return
+        font = float(style.get("font-size", DEFAULT_FONT_SIZE))
+        vp = ctx.vp._replace(font_size=font)
+        own = self._transform(el, style, vp)
+        ctm = multiply(ctx.ctm, own) if own is not None else ctx.ctm
+        inner = replace(ctx, ctm=ctm, style=style, vp=vp, depth=ctx.depth + 1)
+        if style.get("filter", "none").strip().lower() != "none":
+            self.keep_as_is(el, ctx, "filter")
+            return
+        if (
+            own is not None
+            and own != IDENTITY
+            and (el.get("transform-origin") or style.get("transform-origin"))
+        ):
+            self.keep_as_is(el, ctx, "transform-origin: renderers differ")
+            return
+        if tag in SHAPES:
+            self.shape(el, tag, inner, ctx)
+            return
+        start = len(self.records)
+        clip = None
+        if tag in _CONTAINERS:
+            body = inner
+            if tag == "svg" and el is not self.tree.root:
+                entered = self._viewport(el, inner, ctx)
+                if entered is None:
+                    return
+                body, clip = entered
+            children = _switch_child(el) if tag == "switch" else list(el)
+            for child in children:
+                if isinstance(child.tag, str):
+                    self.walk(child, body)
+        elif tag == "use":
+            self.use(el, inner)
+        elif tag != "symbol":
+            self.keep_as_is(el, ctx)
+            return
+        if len(self.records) > start:
+            group_effects.apply(self, el, style, inner, start, clip)
+
+    def _transform(self, el: ET.Element, style: dict[str, str], vp: Viewport) -> Matrix | None:
+        """The element's own transform (CSS ``transform`` wins over the attribute), with its origin."""
+        text = style.get("transform")
+        if text is None:
+            return None
+        m = parse_transform(text) or parse_transform(text, css=True)
+        if m is None:  # ignored, as renderers do
+            self.notes.append(f"ignored the unreadable transform {shown(text)} of {describe(el)}")
+        return m
+
+    def _viewport(
+        self, el: ET.Element, ctx: Ctx, outer: Ctx, size: tuple[float, float] | None = None
+    ) -> tuple[Ctx, str | None] | None:
+        """Enter a nested ``<svg>`` (or a ``<symbol>`` through ``<use>``): its viewport and clip."""
+        vp = outer.vp._replace(font_size=ctx.vp.font_size)
+        x = _length(el.get("x"), vp, "x", 0.0)
+        y = _length(el.get("y"), vp, "y", 0.0)
+        w = size[0] if size else _length(el.get("width"), vp, "x", vp.width)
+        h = size[1] if size else _length(el.get("height"), vp, "y", vp.height)
+        if w <= 0 or h <= 0:
+            return None
+        vb_text = el.get("viewBox")
+        vb = parse_viewbox(vb_text)
+        if vb_text is not None and vb is None:
+            self.notes.append(
+                f"ignored the viewBox {shown(vb_text)} of {describe(el)}: it needs 4 numbers with width, height > 0"
+            )
+        m = (1.0, 0.0, 0.0, 1.0, x, y)
+        if vb is not None:
+            m = multiply(m, viewbox_transform(vb, 0.0, 0.0, w, h, el.get("preserveAspectRatio")))
+        new_vp = Viewport(vb[2] if vb else w, vb[3] if vb else h, ctx.vp.font_size, self.root_font)
+        clip = None
+        clips = vb is not None or local_name(el.tag) == "svg"  # a symbol without viewBox does not clip
+        if clips and ctx.style.get("overflow", "hidden").strip().lower() in ("hidden", "scroll"):
+            corners = [complex(x, y), complex(x + w, y), complex(x + w, y + h), complex(x, y + h)]
+            a, b, c, d, e, f = ctx.ctm
+            doc = [complex(a * p.real + c * p.imag + e, b * p.real + d * p.imag + f) for p in corners]
+            clip = self.resources.clip_rect(doc)
+        return replace(ctx, ctm=multiply(ctx.ctm, m), vp=new_vp), clip
+
+    def use(self, el: ET.Element, ctx: Ctx) -> None:
+        """Draw the element a ``<use>`` refers to, where the ``<use>`` is."""
+        href = href_of(el)
+        target = self.tree.target(href)
+        if target is None:
+            if href and not href.startswith("#"):
+                self.skips["<use> of an external file (not read)"] += 1
+            return
+        if id(target) in ctx.uses or any(a is target for a in self.tree.ancestors(el)) or target is el:
+            self.notes.append(f"skipped a <use> that refers to itself (a reference cycle): {describe(el)}")
+            return
+        x = _length(el.get("x"), ctx.vp, "x", 0.0)
+        y = _length(el.get("y"), ctx.vp, "y", 0.0)
+        inner = replace(
+            ctx,
+            ctm=multiply(ctx.ctm, (1.0, 0.0, 0.0, 1.0, x, y)),
+            uses=(*ctx.uses, id(target)),
+            chain=ctx.chain + self._names.get(id(el), "use") + ">",
+        )
+        tag = local_name(target.tag)
+        if tag in ("symbol", "svg"):
+            self._use_viewport(el, target, tag, inner)
+        else:
+            self.walk(target, inner)
+
+    def _use_viewport(self, use: ET.Element, target: ET.Element, tag: str, ctx: Ctx) -> None:
+        """A ``<symbol>`` or ``<svg>`` drawn through ``<use>``: the use's size sets the viewport."""
+        style = self.cascade.computed(target, ctx.style, self.root_font)
+        if style.get("display", "inline").strip().lower() == "none" and tag == "svg":
+            return
+        w = _length(use.get("width") or target.get("width"), ctx.vp, "x", ctx.vp.width)
+        h = _length(use.get("height") or target.get("height"), ctx.vp, "y", ctx.vp.height)
+        own = self._transform(target, style, ctx.vp) if tag == "svg" else None
+        ctm = multiply(ctx.ctm, own) if own is not None else ctx.ctm
+        inner = replace(ctx, ctm=ctm, style=style, depth=ctx.depth + 1)
+        got = self._viewport(target, inner, ctx, (w, h))
+        if got is None:
+            return
+        entered, clip = got
+        if tag == "symbol":
+            rx = _length(target.get("refX"), entered.vp, "x", 0.0)
+            ry = _length(target.get("refY"), entered.vp, "y", 0.0)
+            if rx or ry:
+                entered = replace(entered, ctm=multiply(entered.ctm, (1.0, 0.0, 0.0, 1.0, -rx, -ry)))
+        start = len(self.records)
+        for child in target:
+            if isinstance(child.tag, str):
+                self.walk(child, entered)
+        if len(self.records) > start:
+            # The symbol's own opacity is not applied (as renderers draw it); its viewport clips.
+            effects = {k: v for k, v in style.items() if k != "opacity"} if tag == "symbol" else style
+            group_effects.apply(self, target, effects, inner, start, clip)
+
+    # -- shapes ---------------------------------------------------------------------------------
+
+    def shape(self, el: ET.Element, tag: str, ctx: Ctx, outer: Ctx) -> None:
+        """Record a drawable shape with what it draws with, then its markers."""
+        style = ctx.style
+        try:
+            geom, reason = shape_geometry(el, tag, ctx.vp, self.paths.get)
+        except KeepAsIs as why:
+            self.keep_as_is(el, outer, str(why))
+            return
+        if geom is None:
+            self.skips[reason or "degenerate (zero size)"] += 1
+            return
+        if style.get("visibility", "visible").strip().lower() != "visible":
+            return
+        empty = geom.path.cubics.shape[0] == 0
+        if empty and not self._markers_wanted(tag, style, geom):
+            self.skips[reason or "degenerate (zero size)"] += 1
+            return
+        box = _box(geom.path)
+        decls = self._paint(style, ctx, box)
+        if decls is None:
+            return  # clipped out entirely
+        stroked = decls.get("stroke", "none") != "none"
+        if stroked and anisotropy(ctx.ctm) > 1.02:
+            self.keep_as_is(el, outer, "stroke under a non-uniform scale")
+            return
+        order = style.get("paint-order", "normal").split()
+        marks = self._markers_wanted(tag, style, geom)
+        markers_first = "markers" in order and (order.index("markers") == 0)
+        if marks and markers_first:
+            self._markers(el, geom, ctx, decls)
+        if not empty:
+            source = ctx.chain + self._names.get(id(el), tag)
+            if marks and "markers" in order and order.index("markers") == 1:
+                # Markers between fill and stroke: the element is drawn in two parts.
+                first, second = order[0], next(w for w in ("fill", "stroke") if w != order[0])
+                self._add_shape(geom.path, ctx.ctm, _only(decls, first), source)
+                self._markers(el, geom, ctx, decls)
+                self._add_shape(geom.path, ctx.ctm, _only(decls, second), source)
+                return
+            self._add_shape(geom.path, ctx.ctm, decls, source)
+        if marks and not markers_first:
+            self._markers(el, geom, ctx, decls)
+
+    def _add_shape(self, path: ArrayPath, ctm: Matrix, decls: dict[str, str], source: str) -> None:
+        self.segments += path.cubics.shape[0]
+        if self.segments > DEFAULT_MAX_SEGMENTS:
+            raise LimitError(f"{self.name} draws more than {DEFAULT_MAX_SEGMENTS:,} path segments")
+        self.records.append(ShapeRecord(path, ctm, decls, source, self._next_order()))
+
+    def _paint(self, style: dict[str, str], ctx: Ctx, box) -> dict[str, str] | None:
+        """The declarations a shape draws with (None: clipped out or masked out entirely)."""
+        ctm, vp = ctx.ctm, ctx.vp
+
+        def server(ref: str):
+            return self.resources.paint_server(ref, ctm, box, vp)
+
+        fill = parse_paint(style.get("fill", "black"), style, server, ctx.context)
+        stroke = parse_paint(style.get("stroke", "none"), style, server, ctx.context)
+        geometry_decls = None
+        if stroke is not None:
+            vector_effect = style.get("vector-effect", "none").strip().lower()
+            scale = 1.0 if vector_effect == "non-scaling-stroke" else scale_of(ctm)
+            geometry_decls = stroke_declarations(style, vp, scale)
+            if geometry_decls is None:
+                stroke = None
+        decls = paint_declarations("fill", fill, unit_value(style.get("fill-opacity"), 1.0))
+        if fill is not None and style.get("fill-rule", "nonzero").strip().lower() == "evenodd":
+            decls["fill-rule"] = "evenodd"
+        decls.update(paint_declarations("stroke", stroke, unit_value(style.get("stroke-opacity"), 1.0)))
+        if geometry_decls:
+            decls.update(geometry_decls)
+        opacity = unit_value(style.get("opacity"), 1.0)
+        if opacity < 1.0:
+            decls["opacity"] = f"{opacity:.6g}"
+        order = style.get("paint-order", "normal").split()
+        if order and order != ["normal"] and order[0] == "stroke":
+            decls["paint-order"] = "stroke"
+        clip = self.resources.clip(style.get("clip-path"), ctm, box, vp)
+        if clip == EMPTY:
+            return None
+        if clip:
+            decls["clip-path"] = f"url(#{clip})"
+        mask = self.resources.mask(style.get("mask"), ctm, box, vp)
+        if mask == EMPTY:
+            return None
+        if mask:
+            decls["mask"] = f"url(#{mask})"
+        return decls
+
+    # -- markers --------------------------------------------------------------------------------
+
+    def _markers_wanted(self, tag: str, style: dict[str, str], geom: Geometry) -> bool:
+        if tag not in _MARKABLE or geom.table is None:
+            return False
+        return any(
+            style.get(k, "none").strip().lower() != "none"
+            for k in ("marker-start", "marker-mid", "marker-end")
+        )
+
+    def _markers(self, el: ET.Element, geom: Geometry, ctx: Ctx, decls: dict[str, str]) -> None:
+        """Draw the markers of a shape as ordinary elements (markers are repetition)."""
+        if geom.table is not None:
+            markers.draw(self, el, geom.table, ctx, decls)
+
+
+def _only(decls: dict[str, str], part: str) -> dict[str, str]:
+    """The declarations of a shape drawing only its fill or only its stroke."""
+    out = dict(decls)
+    if part == "fill":
+        for k in [k for k in out if k.startswith("stroke")]:
+            del out[k]
+        out["stroke"] = "none"
+    else:
+        for k in [k for k in out if k.startswith("fill")]:
+            del out[k]
+        out["fill"] = "none"
+    out.pop("paint-order", None)
+    return out
+
+
+def _box(path: ArrayPath) -> tuple[float, float, float, float] | None:
+    b = tight_bbox(path.cubics)
+    if b is None:
+        return None
+    return (b[0], b[1], b[2] - b[0], b[3] - b[1])
+
+
+def _length(text: str | None, vp: Viewport, axis: str, default: float) -> float:
+    got = parse_length(text) if text is not None else None
+    if got is None:
+        return default
+    v = to_user(got, vp, axis)
+    return v if math.isfinite(v) else default
+
+
+def _switch_child(el: ET.Element) -> list[ET.Element]:
+    """The first child of a ``<switch>`` whose conditions hold (English, no extensions)."""
+    for child in el:
+        if not isinstance(child.tag, str) or local_name(child.tag) is None:
+            continue
+        if child.get("requiredExtensions") is not None:
+            continue
+        langs = child.get("systemLanguage")
+        if langs is not None and not any(x.strip().lower().split("-")[0] == "en" for x in langs.split(",")):
+            continue
+        return [child]
+    return []
+
+
+def _source_names(tree: Tree) -> dict[int, str]:
+    """Names of drawable elements and uses for messages: ``path#leaf`` or ``rect[3]``."""
+    counters: Counter = Counter()
+    names: dict[int, str] = {}
+    for el in tree.root.iter():
+        tag = local_name(el.tag)
+        if tag in SHAPES or tag == "use":
+            el_id = el.get("id")
+            if el_id:
+                names[id(el)] = (
+                    f"{tag}#{el_id}" if el_id.isprintable() and ">" not in el_id else f"{tag}#{shown(el_id)}"
+                )
+            else:
+                names[id(el)] = f"{tag}[{counters[tag]}]"
+            counters[tag] += 1
+    return names
