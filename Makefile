@@ -33,7 +33,7 @@ bench: $(STAMP)
 	@for f in tests/bench/bench_*.py; do echo "== $$f"; QT_QPA_PLATFORM=offscreen $(BIN)/python $$f || exit 1; done
 
 fuzz: $(STAMP)
-	$(BIN)/python tests/fuzz/fuzz_svg.py --seconds $${FUZZ_SECONDS:-60}
+	$(BIN)/python tests/fuzz/fuzz_svg.py --target all --seconds $${FUZZ_SECONDS:-60}
 
 package: $(STAMP)
 	bash packaging/build.sh

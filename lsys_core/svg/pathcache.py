@@ -26,7 +26,9 @@ DEFAULT_MAX_PATH_NUMBERS = 4_000_000
 class PathCache:
     """Parsed path data by ``d`` text: cubics, rows (for markers) and the first error."""
 
-    def __init__(self, tree: Tree, name: str = "<string>", max_segments: int = DEFAULT_MAX_SEGMENTS) -> None:
+    def __init__(self, tree: Tree, name: str = "<string>", max_segments: int | None = None) -> None:
+        if max_segments is None:
+            max_segments = DEFAULT_MAX_SEGMENTS
         ds = list(dict.fromkeys(el.get("d") or "" for el in tree.root.iter() if local_name(el.tag) == "path"))
         self._index = {d: i for i, d in enumerate(ds)}
         try:
@@ -35,8 +37,8 @@ class PathCache:
             raise LimitError(f"{name}: {exc}") from exc
         self._paths: list[ArrayPath] = []
         if self._table is not None:
-            rows = int(self._table.op.size)
-            if rows > max_segments:
+            drawing = int(np.count_nonzero(self._table.op != pd.MOVE))  # rows that draw a segment
+            if drawing > max_segments:
                 raise LimitError(f"{name} has more than {max_segments:,} path segments")
             self._paths = arrays_from_table(self._table, len(ds), max_segments=max_segments, name=name)
             self._bounds = np.searchsorted(self._table.path, np.arange(len(ds) + 1))

@@ -1,16 +1,18 @@
-"""Fuzz the SVG importer (and optionally the ``.lsys`` parser) for a bounded time.
+"""Fuzz the readers -- SVG, ``.lsys``, CSS, path data -- for a bounded time.
 
 Usage::
 
-    python tests/fuzz/fuzz_svg.py --seconds 60 [--target svg|lsys|all] [--seed N] [--per-input 5]
+    python tests/fuzz/fuzz_svg.py --seconds 60 [--target svg|lsys|css|path|all] [--seed N] [--per-input 5]
 
 Hypothesis generates inputs (random SVG trees with broken attributes, ``<use>`` graphs,
-byte-mutated real files, plain junk; token soups for ``.lsys``), in rounds of a few hundred
-examples with fresh seeds until the time budget is spent.  Every input must give a clean
-result or a one-line :class:`~lsys_core.errors.LsysError` (see ``tests/robustness/oracles.py``)
-within ``--per-input`` seconds, under a 2 GiB address-space limit.  On the first failure the
-shrunk input is printed and written to ``tests/fuzz/findings/``, and the exit status is 1;
-turn each finding into a regression test in ``tests/robustness/test_properties.py``.
+byte-mutated real files, plain junk; token soups for ``.lsys``, style sheets and path data), in
+rounds of a few hundred examples with fresh seeds until the time budget is spent (``all`` takes
+the targets in turn).  Every input must give a clean result or a one-line
+:class:`~lsys_core.errors.LsysError` (see ``tests/robustness/oracles.py``) within ``--per-input``
+seconds, under a 2 GiB address-space limit.  On the first failure the shrunk input is printed and
+written to ``tests/fuzz/findings/`` (``TARGET-HASH.txt``: the report; ``TARGET-HASH.input``: the
+input itself), and the exit status is 1.  Every ``.input`` file there is a regression test
+(``tests/robustness/test_fuzz_corpus.py``): keep it once the bug is fixed.
 """
 
 from __future__ import annotations
@@ -31,13 +33,27 @@ sys.path.insert(0, str(ROOT))
 from hypothesis import HealthCheck, Phase, given, seed, settings  # noqa: E402
 from hypothesis.errors import HypothesisWarning  # noqa: E402
 
-from tests.robustness.generators import lsys_texts, svg_bytes  # noqa: E402
-from tests.robustness.oracles import check_lsys_text, check_svg_import  # noqa: E402
+from tests.robustness.generators import css_texts, lsys_texts, path_texts, svg_bytes  # noqa: E402
+from tests.robustness.oracles import (  # noqa: E402
+    check_css_text,
+    check_lsys_text,
+    check_path_data,
+    check_svg_import,
+)
 
 __all__ = ["main"]
 
 FINDINGS = Path(__file__).resolve().parent / "findings"
 MEMORY_LIMIT = 2 << 30
+#: Each target: its input strategy and its oracle.
+TARGETS = {
+    "svg": (svg_bytes, check_svg_import),
+    "lsys": (lsys_texts, check_lsys_text),
+    "css": (css_texts, check_css_text),
+    "path": (path_texts, check_path_data),
+}
+#: The last input that failed, by target (hypothesis shrinks: the last one is the smallest).
+_LAST_FAILURE: dict[str, object] = {}
 
 
 class SlowInput(Exception):
@@ -48,13 +64,16 @@ def _alarm(signum, frame) -> None:
     raise SlowInput("input took longer than the per-input time budget")
 
 
-def _timed(check, per_input: float):
-    """Wrap ``check`` so that one input may run at most ``per_input`` seconds."""
+def _timed(target: str, check, per_input: float):
+    """Wrap ``check`` so that one input may run at most ``per_input`` seconds; remember failures."""
 
     def run(value) -> None:
         signal.setitimer(signal.ITIMER_REAL, per_input)
         try:
             check(value)
+        except BaseException:
+            _LAST_FAILURE[target] = value
+            raise
         finally:
             signal.setitimer(signal.ITIMER_REAL, 0)
 
@@ -63,8 +82,9 @@ def _timed(check, per_input: float):
 
 def _round(target: str, rnd_seed: int, examples: int, per_input: float) -> None:
     """Run one hypothesis round of ``examples`` inputs; raise on the first (shrunk) failure."""
-    strategy, check = (svg_bytes(), check_svg_import) if target == "svg" else (lsys_texts(), check_lsys_text)
-    run = _timed(check, per_input)
+    make, check = TARGETS[target]
+    strategy = make()
+    run = _timed(target, check, per_input)
 
     @seed(rnd_seed)
     @settings(
@@ -101,6 +121,10 @@ def _report(target: str, exc: BaseException) -> None:
         name = hashlib.sha256(notes.encode()).hexdigest()[:12]
         path = FINDINGS / f"{target}-{name}.txt"
         path.write_text(f"{head}\n{notes}\n", encoding="utf-8")
+        value = _LAST_FAILURE.get(target)
+        if value is not None:
+            raw = value if isinstance(value, bytes) else str(value).encode("utf-8", "surrogatepass")
+            path.with_suffix(".input").write_bytes(raw)
         print(f"fuzz: written to {path}", file=sys.stderr)
 
 
@@ -108,7 +132,7 @@ def main(argv: list[str] | None = None) -> int:
     """Fuzz until the time budget is spent or an input fails; return the exit status."""
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--seconds", type=float, default=60.0, help="total time budget (default 60)")
-    p.add_argument("--target", choices=["svg", "lsys", "all"], default="svg")
+    p.add_argument("--target", choices=[*TARGETS, "all"], default="all")
     p.add_argument("--seed", type=int, default=None, help="first round's seed (default: from the clock)")
     p.add_argument("--examples", type=int, default=300, help="inputs per round (default 300)")
     p.add_argument("--per-input", type=float, default=5.0, help="seconds one input may take (default 5)")
@@ -118,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGALRM, _alarm)
     warnings.simplefilter("ignore", HypothesisWarning)
     warnings.simplefilter("error", RuntimeWarning)  # numpy noise on stderr counts as a finding
-    targets = ["svg", "lsys"] if args.target == "all" else [args.target]
+    targets = list(TARGETS) if args.target == "all" else [args.target]
     base = args.seed if args.seed is not None else int(time.time())
     deadline = time.monotonic() + args.seconds
     rounds = inputs = 0

@@ -20,9 +20,11 @@ from hypothesis import strategies as st
 
 __all__ = [
     "NS",
+    "css_texts",
     "hostile_rules",
     "hostile_svgs",
     "lsys_texts",
+    "path_texts",
     "seed_svgs",
     "svg",
     "svg_bytes",
@@ -421,3 +423,38 @@ def lsys_texts(draw) -> str:
         toks = draw(st.lists(st.sampled_from(_LSYS_TOKENS), max_size=12))
         lines.append(" ".join(toks))
     return draw(st.sampled_from(["\n", "\r\n", "\r"])).join(lines) + draw(st.sampled_from(["", "\n"]))
+
+
+# ---------------------------------------------------------------------------
+# CSS and path data on their own (fuzz targets of their parsers)
+
+_CSS_TOKENS = _words(
+    "rect path g svg * .a .b #i #x [x] [x=1] [fill~=red] :first-child :last-child :hover ::before "
+    "> + ~ , { } ; : fill stroke opacity transform marker display none red #f00 url(#g) "
+    "!important @import @media @font-face screen print 1 2.5 -3 1e9 nan inf em % px ' \" /* */ "
+    "\\ \\41 ( ) [ ] <!-- --> @ url( rgb( hsl( calc("
+)
+
+
+@st.composite
+def css_texts(draw) -> str:
+    """Style sheets: token soups (unterminated strings, comments and blocks included)."""
+    tokens = draw(st.lists(st.sampled_from(_CSS_TOKENS), max_size=60))
+    seps = draw(st.lists(st.sampled_from(["", " ", "\n", "\t"]), min_size=len(tokens), max_size=len(tokens)))
+    text = "".join(t + s for t, s in zip(tokens, seps, strict=True))
+    if draw(st.booleans()):
+        text += draw(st.text(max_size=40))
+    return text
+
+
+_PATH_TOKENS = _words(
+    "M m L l H h V v C c S s Q q T t A a Z z 0 1 -1 .5 1e3 1e-3 -.5e+2 1.5.5 1e 1e400 nan , x"
+)
+
+
+@st.composite
+def path_texts(draw) -> str:
+    """Path data: command and number soups (flags without separators, broken numbers included)."""
+    tokens = draw(st.lists(st.sampled_from(_PATH_TOKENS), max_size=80))
+    seps = draw(st.lists(st.sampled_from(["", " ", ","]), min_size=len(tokens), max_size=len(tokens)))
+    return "".join(t + s for t, s in zip(tokens, seps, strict=True))

@@ -15,7 +15,14 @@ from lsys_core.grammar import Grammar, format_grammar, parse_grammar
 from lsys_core.svg.model import Scene
 from lsys_core.svg.parse import parse_svg
 
-__all__ = ["check_lsys_text", "check_message", "check_scene", "check_svg_import"]
+__all__ = [
+    "check_css_text",
+    "check_lsys_text",
+    "check_message",
+    "check_path_data",
+    "check_scene",
+    "check_svg_import",
+]
 
 
 def check_message(exc: LsysError) -> None:
@@ -73,3 +80,55 @@ def check_lsys_text(text: str) -> Grammar | None:
     back = parse_grammar(format_grammar(g))
     assert back == g
     return g
+
+
+_CSS_TREE = (
+    '<svg xmlns="http://www.w3.org/2000/svg"><g class="a" id="i"><rect x="1" class="b a"/>'
+    '<path id="x" fill="red"/></g><rect/></svg>'
+)
+
+
+def check_css_text(text: str) -> None:
+    """Read a style sheet and match it against a small tree, then as a ``style`` attribute.
+
+    The only acceptable failure is a one-line :class:`LsysError` (the matching work limit).
+    """
+    import xml.etree.ElementTree as ET
+
+    from lsys_core.svg.css import StyleSheet, parse_declarations
+    from lsys_core.svg.tree import Tree
+
+    tree = Tree(ET.fromstring(_CSS_TREE))
+    sheet = StyleSheet()
+    try:
+        sheet.add(text)
+        for el in tree.root.iter():
+            for rule in sheet.matching(el, tree):
+                assert all(isinstance(d.value, str) for d in rule.declarations)
+        for d in parse_declarations(text):
+            assert d.name == d.name.lower()
+    except LsysError as exc:
+        check_message(exc)
+    for note in sheet.notes:
+        assert "\n" not in note
+
+
+def check_path_data(text: str) -> None:
+    """Read path data strictly, leniently and in a batch; the three must agree."""
+    from lsys_core.errors import SvgError
+    from lsys_core.geometry.paths import cubics_from_d, path_from_d, paths_from_ds
+
+    path, error = path_from_d(text)
+    c = path.cubics
+    assert c.ndim == 2 and c.shape[1] == 4 and path.subpaths.shape == (len(c),)
+    assert len(path.closed) == (int(path.subpaths.max()) + 1 if len(c) else 0)
+    try:
+        strict, _, _ = cubics_from_d(text)
+    except SvgError as exc:
+        check_message(exc)
+        assert error is not None
+    else:
+        assert error is None and np.array_equal(strict, c, equal_nan=True)
+    (batched, batch_error), _ = paths_from_ds([text, "M0 0 L1 1"])
+    assert batch_error == error
+    assert batched.cubics.shape == c.shape
