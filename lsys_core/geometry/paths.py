@@ -17,21 +17,19 @@ import numpy as np
 
 from lsys_core.errors import LimitError, SvgError
 from lsys_core.geometry import pathdata as pd
+from lsys_core.geometry.arcs import arc_cubics, arc_setup, fill_arcs
 from lsys_core.geometry.pathdata import PathTable, parse_path, parse_paths
 
 __all__ = [
     "ArrayPath",
-    "RawPath",
     "arc_cubics",
     "arrays_from_table",
     "assemble",
     "cubics_from_d",
-    "cubics_from_path",
     "cubics_from_table",
     "d_from_cubics",
     "path_from_d",
     "paths_from_ds",
-    "raw_from_segments",
 ]
 
 #: Segment kinds collected while walking a path (converted to cubics at the end).
@@ -46,118 +44,10 @@ MAX_COORD = 1e12
 
 #: Default significant digits of numbers written into path data (relative error <= 5e-9).
 DEFAULT_PRECISION = 9
-#: Exceptions svgelements raises on values it cannot handle (shared with the importer).
-SVGELEMENTS_ERRORS = (
-    ValueError,
-    TypeError,
-    IndexError,
-    KeyError,
-    AttributeError,
-    ZeroDivisionError,
-    OverflowError,
-)
-
-
-class RawPath(NamedTuple):
-    """Segments collected from path data before conversion to arrays.
-
-    ``pts`` holds one 4-tuple of complex per segment: ``p0 c1 c2 p3`` for cubics,
-    ``p0 q q p3`` for quadratics and ``p0 p0 p3 p3`` for lines (``kinds`` says which);
-    ``subs`` the subpath of each segment and ``closed`` one flag per subpath.
-    """
-
-    kinds: list[int]
-    pts: list[tuple[complex, complex, complex, complex]]
-    subs: list[int]
-    closed: list[bool]
 
 
 def _empty() -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
     return np.zeros((0, 4), dtype=complex), np.zeros(0, dtype=np.intp), ()
-
-
-def _close(raw: RawPath, cur: complex, start: complex) -> None:
-    """Close the current subpath: add a line back to ``start`` unless it ends there."""
-    if abs(cur - start) > _CLOSE_TOL * max(abs(cur), abs(start)):
-        raw.kinds.append(_LINE)
-        raw.pts.append((cur, cur, start, start))
-        raw.subs.append(len(raw.closed) - 1)
-    elif cur != start:  # rounding noise (e.g. after arcs): end exactly at the start
-        last = raw.pts[-1]
-        raw.pts[-1] = (last[0], last[1], last[2], start)
-    raw.closed[-1] = True
-
-
-def raw_from_segments(path) -> RawPath:
-    """Collect the segments of an svgelements path (or iterable of its segments).
-
-    Zero-length segments and subpaths without segments are dropped; arcs are
-    converted to cubics (a zero-radius arc to a line).
-    """
-    from svgelements import Arc, Close, CubicBezier, Move, QuadraticBezier
-
-    raw = RawPath([], [], [], [])
-    kinds, pts, subs, closed = raw
-    start = 0j  # start point of the current subpath
-    pending = True  # a new subpath begins with the next drawn segment
-    for seg in path:
-        kind = type(seg)
-        if kind is Move:
-            end = seg.end
-            start = complex(end.x, end.y)
-            pending = True
-            continue
-        if seg.start is None or seg.end is None:
-            continue
-        p0 = complex(seg.start.x, seg.start.y)
-        p3 = complex(seg.end.x, seg.end.y)
-        if kind is Close:
-            if not pending:
-                _close(raw, p0, start)
-            pending = True  # drawing after Z starts a new subpath at the same point
-            continue
-        if kind is CubicBezier:
-            c1, c2 = seg.control1, seg.control2
-            row = (p0, complex(c1.x, c1.y), complex(c2.x, c2.y), p3)
-            code = _CUBIC
-        elif kind is QuadraticBezier:
-            c = complex(seg.control.x, seg.control.y)
-            row = (p0, c, c, p3)
-            code = _QUAD
-        elif kind is Arc:
-            curves = list(seg.as_cubic_curves()) if seg.rx and seg.ry else []
-            if curves:
-                if pending:
-                    closed.append(False)
-                    pending = False
-                    start = p0
-                for cb in curves:
-                    kinds.append(_CUBIC)
-                    pts.append(
-                        (
-                            complex(cb.start.x, cb.start.y),
-                            complex(cb.control1.x, cb.control1.y),
-                            complex(cb.control2.x, cb.control2.y),
-                            complex(cb.end.x, cb.end.y),
-                        )
-                    )
-                    subs.append(len(closed) - 1)
-                continue
-            row = (p0, p0, p3, p3)  # zero radius: the arc is a straight line (SVG 1.1 F.6.2)
-            code = _LINE
-        else:  # Line and any other linear segment
-            row = (p0, p0, p3, p3)
-            code = _LINE
-        if row[0] == row[1] == row[2] == row[3]:
-            continue
-        if pending:
-            closed.append(False)
-            pending = False
-            start = p0
-        kinds.append(code)
-        pts.append(row)
-        subs.append(len(closed) - 1)
-    return raw
 
 
 class ArrayPath(NamedTuple):
@@ -198,35 +88,6 @@ def assemble(paths: list[ArrayPath]) -> tuple[np.ndarray, np.ndarray, np.ndarray
     cubics = np.concatenate([p.cubics for p in paths])
     subpaths = np.concatenate([p.subpaths for p in paths]).astype(np.intp)
     return cubics, subpaths, counts
-
-
-def _to_arrays(raw: RawPath) -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
-    if not raw.pts:
-        return _empty()
-    cubics = np.array(raw.pts, dtype=complex).reshape(-1, 4)
-    _elevate(cubics, np.array(raw.kinds, dtype=np.int8))
-    return cubics, np.array(raw.subs, dtype=np.intp), tuple(raw.closed)
-
-
-def cubics_from_path(path) -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
-    """Convert an svgelements path (or any iterable of its segments) to cubic arrays.
-
-    Parameters
-    ----------
-    path : svgelements.Path or iterable of svgelements segments
-        The path, with its transform already applied to the points.
-
-    Returns
-    -------
-    cubics : ndarray of complex, shape (k, 4)
-        Control points of every drawn segment; zero-length segments are dropped.
-    subpaths : ndarray of int, shape (k,)
-        Subpath index of each segment (subpaths without segments are dropped).
-    closed : tuple of bool
-        Whether each subpath ends with ``Z``.  A closing segment back to the
-        subpath's start is added to ``cubics`` when the subpath does not end there.
-    """
-    return _to_arrays(raw_from_segments(path))
 
 
 def _elevate(cubics: np.ndarray, kinds: np.ndarray) -> None:
@@ -344,7 +205,7 @@ def _convert(
         seg_row = keep
     else:
         # Every kept row takes one slot, every curved arc as many as it has pieces, in row order.
-        setup = _arc_setup(pts[curved, 0], pts[curved, 3], table.arc[sel])
+        setup = arc_setup(pts[curved, 0], pts[curved, 3], table.arc[sel])
         slots = rows.astype(np.intp)
         slots[curved] = setup.pieces
         offset = np.cumsum(slots) - slots
@@ -355,127 +216,13 @@ def _convert(
         _elevate(plain, kinds[keep])
         cub[offset[keep]] = plain
         del plain
-        _fill_arcs(cub, offset[curved], setup, pts[curved, 0], pts[curved, 3])
+        fill_arcs(cub, offset[curved], setup, pts[curved, 0], pts[curved, 3])
         seg_row = np.repeat(np.arange(n), slots)
     seg_sub = sub[seg_row]
     change = np.ones(seg_sub.size, dtype=bool)
     change[1:] = seg_sub[1:] != seg_sub[:-1]  # subpath numbers never decrease: renumber the runs
     subpaths = np.cumsum(change) - 1
     return cub, subpaths, closed_sub[seg_sub[change]].tolist(), table.path[seg_row]
-
-
-#: Arcs converted at a time (bounds the temporary memory of the conversion).
-_ARC_CHUNK = 65536
-
-
-class _ArcSetup(NamedTuple):
-    """Centre parameterisation of arcs (SVG F.6.5) and the number of cubic pieces of each."""
-
-    cx: np.ndarray
-    cy: np.ndarray
-    rx: np.ndarray
-    ry: np.ndarray
-    cphi: np.ndarray
-    sphi: np.ndarray
-    theta1: np.ndarray
-    dtheta: np.ndarray
-    pieces: np.ndarray
-
-
-def _arc_setup(p0: np.ndarray, p3: np.ndarray, arc: np.ndarray) -> _ArcSetup:
-    """Convert endpoint to centre parameterisation (radii grown where too small), vectorised."""
-    rx, ry = np.abs(arc[:, 0]), np.abs(arc[:, 1])
-    phi = np.deg2rad(np.mod(arc[:, 2], 360.0))
-    large, sweep = arc[:, 3] != 0, arc[:, 4] != 0
-    cphi, sphi = np.cos(phi), np.sin(phi)
-    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-        hx, hy = (p0.real - p3.real) / 2.0, (p0.imag - p3.imag) / 2.0
-        x1, y1 = cphi * hx + sphi * hy, -sphi * hx + cphi * hy
-        grow = np.sqrt(np.maximum((x1 / rx) ** 2 + (y1 / ry) ** 2, 1.0))
-        rx, ry = rx * grow, ry * grow
-        num = (rx * ry) ** 2 - (rx * y1) ** 2 - (ry * x1) ** 2
-        den = (rx * y1) ** 2 + (ry * x1) ** 2
-        coef = np.sqrt(np.maximum(num / den, 0.0))
-        coef = np.where(large == sweep, -coef, coef)
-        cxp, cyp = coef * rx * y1 / ry, -coef * ry * x1 / rx
-        cx = cphi * cxp - sphi * cyp + (p0.real + p3.real) / 2.0
-        cy = sphi * cxp + cphi * cyp + (p0.imag + p3.imag) / 2.0
-        theta1 = np.arctan2((y1 - cyp) / ry, (x1 - cxp) / rx)
-        theta2 = np.arctan2((-y1 - cyp) / ry, (-x1 - cxp) / rx)
-        dtheta = np.mod(theta2 - theta1, 2 * np.pi)
-        dtheta = np.where(~sweep & (dtheta > 0), dtheta - 2 * np.pi, dtheta)
-        dtheta = np.where(np.isfinite(dtheta), dtheta, 0.0)
-        count = np.maximum(np.ceil(np.abs(dtheta) / (np.pi / 4) - 1e-9), 1).astype(np.intp)
-    return _ArcSetup(cx, cy, rx, ry, cphi, sphi, theta1, dtheta, count)
-
-
-def _arc_pieces(a: _ArcSetup, p0: np.ndarray, p3: np.ndarray) -> np.ndarray:
-    """Return the cubic pieces of arcs (all pieces of the first arc, then of the next...)."""
-    count = a.pieces
-    # Boundary angles: count + 1 per arc; piece j of an arc runs from boundary j to j + 1.
-    nb = count + 1
-    own = np.repeat(np.arange(count.size), nb)
-    j = np.arange(own.size) - np.repeat(np.cumsum(nb) - nb, nb)
-    delta = a.dtheta / count
-    ang = a.theta1[own] + j * delta[own]
-    ca, sa = np.cos(ang), np.sin(ang)
-    rx, ry, c, s = a.rx[own], a.ry[own], a.cphi[own], a.sphi[own]
-    with np.errstate(invalid="ignore", over="ignore"):
-        ex, ey = rx * ca, ry * sa  # point on the axis-aligned ellipse
-        dx, dy = -rx * sa, ry * ca  # its tangent (per radian)
-        pt = (a.cx[own] + c * ex - s * ey) + 1j * (a.cy[own] + s * ex + c * ey)
-        tan = (c * dx - s * dy) + 1j * (s * dx + c * dy)
-        k = (4.0 / 3.0 * np.tan(delta / 4.0))[own]
-    is_start = np.ones(own.size, dtype=bool)
-    is_start[np.cumsum(nb) - 1] = False
-    b = np.flatnonzero(is_start)  # the boundary starting each piece
-    cubics = np.empty((b.size, 4), dtype=complex)
-    with np.errstate(invalid="ignore", over="ignore"):
-        cubics[:, 0] = pt[b]
-        cubics[:, 1] = pt[b] + k[b] * tan[b]
-        cubics[:, 2] = pt[b + 1] - k[b] * tan[b + 1]
-        cubics[:, 3] = pt[b + 1]
-    first = np.cumsum(count) - count
-    cubics[first, 0] = p0  # exact end points
-    cubics[first + count - 1, 3] = p3
-    return cubics
-
-
-def _slice_setup(a: _ArcSetup, sl: slice) -> _ArcSetup:
-    return _ArcSetup(*(f[sl] for f in a))
-
-
-def arc_cubics(p0: np.ndarray, p3: np.ndarray, arc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Approximate elliptical arcs (SVG endpoint parameterisation) by cubics, vectorised.
-
-    Parameters
-    ----------
-    p0, p3 : ndarray of complex, shape (n,)
-        Start and end points (distinct); radii must be non-zero.
-    arc : ndarray, shape (n, 5)
-        ``rx ry phi(degrees) large-arc-flag sweep-flag`` per arc.
-
-    Returns
-    -------
-    cubics : ndarray of complex, shape (m, 4)
-        Pieces of at most 45 degrees each (error below 5e-6 of the radius).
-    owner : ndarray of int, shape (m,)
-        The arc each piece belongs to (pieces of one arc are consecutive, in drawing order).
-    """
-    setup = _arc_setup(p0, p3, arc)
-    cubics = np.empty((int(setup.pieces.sum()), 4), dtype=complex)
-    _fill_arcs(cubics, np.cumsum(setup.pieces) - setup.pieces, setup, p0, p3)
-    return cubics, np.repeat(np.arange(p0.size), setup.pieces)
-
-
-def _fill_arcs(out: np.ndarray, slot: np.ndarray, setup: _ArcSetup, p0: np.ndarray, p3: np.ndarray) -> None:
-    """Write the pieces of every arc into ``out`` from row ``slot[i]`` on, a chunk of arcs at a time."""
-    for i in range(0, p0.size, _ARC_CHUNK):
-        sl = slice(i, i + _ARC_CHUNK)
-        part = _slice_setup(setup, sl)
-        pieces = _arc_pieces(part, p0[sl], p3[sl])
-        within = np.arange(pieces.shape[0]) - np.repeat(np.cumsum(part.pieces) - part.pieces, part.pieces)
-        out[np.repeat(slot[sl], part.pieces) + within] = pieces
 
 
 def cubics_from_d(d: str) -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:

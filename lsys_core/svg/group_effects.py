@@ -14,8 +14,8 @@ import xml.etree.ElementTree as ET
 from typing import TYPE_CHECKING
 
 from lsys_core.geometry.bezier import transform_cubics
+from lsys_core.svg.masking import EMPTY
 from lsys_core.svg.paint import unit_value
-from lsys_core.svg.resources import EMPTY
 from lsys_core.svg.shapes import tight_bbox
 from lsys_core.svg.tree import describe
 from lsys_core.svg.values import IDENTITY, invert, multiply

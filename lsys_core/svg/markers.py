@@ -65,7 +65,7 @@ def _tangents(p: tuple[complex, complex, complex, complex]) -> tuple[complex | N
 
 def _arc_tangents(row: np.ndarray, arc: np.ndarray) -> tuple[complex | None, complex | None]:
     """Tangents of an arc row (a straight line when a radius is zero)."""
-    from lsys_core.geometry.paths import arc_cubics
+    from lsys_core.geometry.arcs import arc_cubics
 
     p0, p3 = complex(row[0]), complex(row[3])
     if abs(p3 - p0) <= _EPS * max(1.0, abs(p0)):

@@ -12,7 +12,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from lsys_core.svg.values import Matrix, Viewport, hex_of, parse_color, parse_length, to_user
+from lsys_core.svg.colors import hex_of, parse_color
+from lsys_core.svg.values import Matrix, Viewport, parse_length, to_user
 
 __all__ = ["Paint", "parse_paint", "scale_of", "stroke_declarations", "unit_value"]
 

@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
+from lsys_core.svg.colors import parse_color
 from lsys_core.svg.css import StyleSheet, parse_declarations
 from lsys_core.svg.tree import Tree
-from lsys_core.svg.values import parse_color, parse_length, parse_number, parse_numbers
+from lsys_core.svg.values import parse_length, parse_number, parse_numbers
 
 __all__ = ["INHERITED", "PROPERTIES", "Cascade", "font_size_px", "valid"]
 

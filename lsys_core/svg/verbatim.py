@@ -4,7 +4,7 @@ A copy must draw the same outside its document: its cascaded declarations (from 
 presentation attributes and ``style``) are written into its ``style`` attributes, what it inherits
 from its ancestors goes on a wrapping ``<g>`` together with the transform to document
 coordinates, ``xlink:href`` becomes ``href``, and everything it refers to by ``url(#id)`` or
-``href="#id"`` is copied into the scene's definitions (:meth:`Resources.raw`).
+``href="#id"`` is copied into the scene's definitions (:meth:`.resources.Resources.raw`).
 """
 
 from __future__ import annotations

@@ -12,7 +12,6 @@ its content is known.
 
 from __future__ import annotations
 
-import math
 import xml.etree.ElementTree as ET
 from collections import Counter
 from dataclasses import dataclass, field, replace
@@ -21,6 +20,7 @@ from lsys_core.errors import LimitError
 from lsys_core.geometry.paths import ArrayPath
 from lsys_core.svg import group_effects, markers
 from lsys_core.svg.css import StyleSheet
+from lsys_core.svg.masking import EMPTY, Definitions
 from lsys_core.svg.paint import (
     anisotropy,
     paint_declarations,
@@ -30,8 +30,18 @@ from lsys_core.svg.paint import (
     unit_value,
 )
 from lsys_core.svg.pathcache import DEFAULT_MAX_SEGMENTS, PathCache
-from lsys_core.svg.resources import EMPTY, Resources
-from lsys_core.svg.shapes import Geometry, KeepAsIs, shape_geometry, tight_bbox
+from lsys_core.svg.records import (
+    SHAPES,
+    Ctx,
+    ShapeRecord,
+    VerbatimRecord,
+    box_of,
+    length_or,
+    only_part,
+    source_names,
+    switch_child,
+)
+from lsys_core.svg.shapes import Geometry, KeepAsIs, shape_geometry
 from lsys_core.svg.style import DEFAULT_FONT_SIZE, Cascade
 from lsys_core.svg.tree import Tree, describe, href_of, local_name, shown
 from lsys_core.svg.values import (
@@ -39,17 +49,14 @@ from lsys_core.svg.values import (
     Matrix,
     Viewport,
     multiply,
-    parse_length,
     parse_transform,
     parse_viewbox,
-    to_user,
     viewbox_transform,
 )
 from lsys_core.svg.verbatim import inherited_declarations, wrap
 
 __all__ = ["Ctx", "Reader", "ShapeRecord", "VerbatimRecord"]
 
-SHAPES = frozenset({"path", "rect", "circle", "ellipse", "line", "polyline", "polygon"})
 _MARKABLE = frozenset({"path", "line", "polyline", "polygon"})
 _CONTAINERS = frozenset({"g", "a", "switch", "svg"})
 #: Elements that draw nothing where they stand.
@@ -63,39 +70,6 @@ _NOT_DRAWN = frozenset(
 _ANIMATION = frozenset({"animate", "animateMotion", "animateTransform", "animateColor", "set"})
 #: Content kept as is (not geometry to infer rules from).
 _VERBATIM = frozenset({"text", "image", "foreignObject"})
-
-
-@dataclass
-class ShapeRecord:
-    """A drawable shape: geometry in its own coordinates, its matrix to document coordinates."""
-
-    path: ArrayPath
-    ctm: Matrix
-    style: dict[str, str]
-    source: str
-    order: int
-
-
-@dataclass
-class VerbatimRecord:
-    """Content kept as is: markup in document coordinates."""
-
-    xml: str
-    what: str
-    order: int
-
-
-@dataclass(frozen=True)
-class Ctx:
-    """What an element inherits from where it is drawn."""
-
-    ctm: Matrix
-    style: dict[str, str]
-    vp: Viewport
-    depth: int = 0
-    uses: tuple[int, ...] = ()
-    chain: str = ""
-    context: dict | None = None
 
 
 @dataclass
@@ -120,11 +94,11 @@ class Reader:
         self.cascade = Cascade(self.tree, sheet)
         self.paths = PathCache(self.tree, self.name)
         self.segments = 0
-        self.resources = Resources(
+        self.resources = Definitions(
             self.tree, self.style_at, self.cascade.specified, self._clip_geometry, self.notes
         )
         self._style_cache: dict[int, dict[str, str]] = {}
-        self._names = _source_names(self.tree)
+        self._names = source_names(self.tree)
         self.order = 0
         self.root_font = DEFAULT_FONT_SIZE
 
@@ -213,7 +187,7 @@ class Reader:
                 if entered is None:
                     return
                 body, clip = entered
-            children = _switch_child(el) if tag == "switch" else list(el)
+            children = switch_child(el) if tag == "switch" else list(el)
             for child in children:
                 if isinstance(child.tag, str):
                     self.walk(child, body)
@@ -240,10 +214,10 @@ class Reader:
     ) -> tuple[Ctx, str | None] | None:
         """Enter a nested ``<svg>`` (or a ``<symbol>`` through ``<use>``): its viewport and clip."""
         vp = outer.vp._replace(font_size=ctx.vp.font_size)
-        x = _length(el.get("x"), vp, "x", 0.0)
-        y = _length(el.get("y"), vp, "y", 0.0)
-        w = size[0] if size else _length(el.get("width"), vp, "x", vp.width)
-        h = size[1] if size else _length(el.get("height"), vp, "y", vp.height)
+        x = length_or(el.get("x"), vp, "x", 0.0)
+        y = length_or(el.get("y"), vp, "y", 0.0)
+        w = size[0] if size else length_or(el.get("width"), vp, "x", vp.width)
+        h = size[1] if size else length_or(el.get("height"), vp, "y", vp.height)
         if w <= 0 or h <= 0:
             return None
         vb_text = el.get("viewBox")
@@ -276,8 +250,8 @@ class Reader:
         if id(target) in ctx.uses or any(a is target for a in self.tree.ancestors(el)) or target is el:
             self.notes.append(f"skipped a <use> that refers to itself (a reference cycle): {describe(el)}")
             return
-        x = _length(el.get("x"), ctx.vp, "x", 0.0)
-        y = _length(el.get("y"), ctx.vp, "y", 0.0)
+        x = length_or(el.get("x"), ctx.vp, "x", 0.0)
+        y = length_or(el.get("y"), ctx.vp, "y", 0.0)
         inner = replace(
             ctx,
             ctm=multiply(ctx.ctm, (1.0, 0.0, 0.0, 1.0, x, y)),
@@ -295,8 +269,8 @@ class Reader:
         style = self.cascade.computed(target, ctx.style, self.root_font)
         if style.get("display", "inline").strip().lower() == "none" and tag == "svg":
             return
-        w = _length(use.get("width") or target.get("width"), ctx.vp, "x", ctx.vp.width)
-        h = _length(use.get("height") or target.get("height"), ctx.vp, "y", ctx.vp.height)
+        w = length_or(use.get("width") or target.get("width"), ctx.vp, "x", ctx.vp.width)
+        h = length_or(use.get("height") or target.get("height"), ctx.vp, "y", ctx.vp.height)
         own = self._transform(target, style, ctx.vp) if tag == "svg" else None
         ctm = multiply(ctx.ctm, own) if own is not None else ctx.ctm
         inner = replace(ctx, ctm=ctm, style=style, depth=ctx.depth + 1)
@@ -305,8 +279,8 @@ class Reader:
             return
         entered, clip = got
         if tag == "symbol":
-            rx = _length(target.get("refX"), entered.vp, "x", 0.0)
-            ry = _length(target.get("refY"), entered.vp, "y", 0.0)
+            rx = length_or(target.get("refX"), entered.vp, "x", 0.0)
+            ry = length_or(target.get("refY"), entered.vp, "y", 0.0)
             if rx or ry:
                 entered = replace(entered, ctm=multiply(entered.ctm, (1.0, 0.0, 0.0, 1.0, -rx, -ry)))
         start = len(self.records)
@@ -337,7 +311,7 @@ class Reader:
         if empty and not self._markers_wanted(tag, style, geom):
             self.skips[reason or "degenerate (zero size)"] += 1
             return
-        box = _box(geom.path)
+        box = box_of(geom.path)
         decls = self._paint(style, ctx, box)
         if decls is None:
             return  # clipped out entirely
@@ -355,9 +329,9 @@ class Reader:
             if marks and "markers" in order and order.index("markers") == 1:
                 # Markers between fill and stroke: the element is drawn in two parts.
                 first, second = order[0], next(w for w in ("fill", "stroke") if w != order[0])
-                self._add_shape(geom.path, ctx.ctm, _only(decls, first), source)
+                self._add_shape(geom.path, ctx.ctm, only_part(decls, first), source)
                 self._markers(el, geom, ctx, decls)
-                self._add_shape(geom.path, ctx.ctm, _only(decls, second), source)
+                self._add_shape(geom.path, ctx.ctm, only_part(decls, second), source)
                 return
             self._add_shape(geom.path, ctx.ctm, decls, source)
         if marks and not markers_first:
@@ -423,65 +397,3 @@ class Reader:
         """Draw the markers of a shape as ordinary elements (markers are repetition)."""
         if geom.table is not None:
             markers.draw(self, el, geom.table, ctx, decls)
-
-
-def _only(decls: dict[str, str], part: str) -> dict[str, str]:
-    """The declarations of a shape drawing only its fill or only its stroke."""
-    out = dict(decls)
-    if part == "fill":
-        for k in [k for k in out if k.startswith("stroke")]:
-            del out[k]
-        out["stroke"] = "none"
-    else:
-        for k in [k for k in out if k.startswith("fill")]:
-            del out[k]
-        out["fill"] = "none"
-    out.pop("paint-order", None)
-    return out
-
-
-def _box(path: ArrayPath) -> tuple[float, float, float, float] | None:
-    b = tight_bbox(path.cubics)
-    if b is None:
-        return None
-    return (b[0], b[1], b[2] - b[0], b[3] - b[1])
-
-
-def _length(text: str | None, vp: Viewport, axis: str, default: float) -> float:
-    got = parse_length(text) if text is not None else None
-    if got is None:
-        return default
-    v = to_user(got, vp, axis)
-    return v if math.isfinite(v) else default
-
-
-def _switch_child(el: ET.Element) -> list[ET.Element]:
-    """The first child of a ``<switch>`` whose conditions hold (English, no extensions)."""
-    for child in el:
-        if not isinstance(child.tag, str) or local_name(child.tag) is None:
-            continue
-        if child.get("requiredExtensions") is not None:
-            continue
-        langs = child.get("systemLanguage")
-        if langs is not None and not any(x.strip().lower().split("-")[0] == "en" for x in langs.split(",")):
-            continue
-        return [child]
-    return []
-
-
-def _source_names(tree: Tree) -> dict[int, str]:
-    """Names of drawable elements and uses for messages: ``path#leaf`` or ``rect[3]``."""
-    counters: Counter = Counter()
-    names: dict[int, str] = {}
-    for el in tree.root.iter():
-        tag = local_name(el.tag)
-        if tag in SHAPES or tag == "use":
-            el_id = el.get("id")
-            if el_id:
-                names[id(el)] = (
-                    f"{tag}#{el_id}" if el_id.isprintable() and ">" not in el_id else f"{tag}#{shown(el_id)}"
-                )
-            else:
-                names[id(el)] = f"{tag}[{counters[tag]}]"
-            counters[tag] += 1
-    return names
