@@ -284,6 +284,8 @@ def _compact(d: str) -> str:
 def _values(a, b, scale, uses: _Uses, drawing) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """Return the numbers of every ``<use>`` (a mask says which its format takes) and the formats."""
     n = a.size
+    if not uses.pieces:  # every instance is baked (url() paint or clip): no <use> at all
+        return np.zeros((n, 4)), np.zeros((n, 4), bool), [""]
     vb = _canvas(drawing)[0]
     size = max(abs(vb[2]), abs(vb[3]), 1e-300)
     s = np.abs(a)

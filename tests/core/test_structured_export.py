@@ -390,6 +390,19 @@ def test_defs_verbatim_and_url_styles_are_carried_through() -> None:
     assert [local(el) for el in root.find(f"{{{SVG_NS}}}defs") if el.get("id") != "g"] == ["circle"]
 
 
+def test_a_drawing_whose_every_instance_is_baked() -> None:
+    g = parse_grammar(
+        "lsys 2\n"
+        'defs "<clipPath id=\\"c\\"><rect width=\\"30\\" height=\\"10\\"/></clipPath>"\n'
+        'terminal S "M0 0 H20 V20 H0 Z" style "fill:#00f;clip-path:url(#c)"\n'
+        "axiom: S f(25) S\n"
+    )
+    svg = drawing_to_structured_svg(derive(g))
+    check_document(svg)
+    body = svg.split("</defs>")[1]
+    assert body.count("clip-path:url(#c)") == 2 and "<use" not in body
+
+
 @pytest.mark.skipif(shutil.which("inkscape") is None, reason="needs Inkscape")
 def test_inkscape_sees_the_groups_and_the_clones(tmp_path) -> None:
     g = parse_grammar((ROOT / "resources" / "examples" / "facade.lsys").read_text(encoding="utf-8"))
