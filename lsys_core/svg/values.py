@@ -276,6 +276,9 @@ def _transform_args(inner: str, name: str, css: bool) -> list[float] | None:
 
 
 def _one_transform(name: str, a: list[float]) -> Matrix:
+    if name in ("rotate", "skewx", "skewy") and not math.isfinite(a[0]):
+        nan = math.nan  # an overflowing angle (1e999): what it draws is skipped as non-finite
+        return (nan, nan, nan, nan, nan, nan)
     if name == "matrix":
         return (a[0], a[1], a[2], a[3], a[4], a[5])
     if name == "translate":

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import random
 
 import pytest
@@ -47,5 +48,7 @@ def test_single_numbers_and_lengths():
     assert values.parse_number(" 12.5 ") == 12.5
     assert values.parse_number("1 2") is None
     assert values.parse_number("1e400") is None
+    rotated = values.parse_transform("rotate(1e999)")  # no math domain error: a non-finite matrix
+    assert rotated is not None and all(math.isnan(v) for v in rotated)
     assert values.parse_length("3mm") == values.Length(3.0, "mm")
     assert parse_color("rgb(0 128 0 / 50%)") == (0.0, 128 / 255, 0.0, 0.5)
