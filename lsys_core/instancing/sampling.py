@@ -17,6 +17,7 @@ __all__ = ["Samples", "arc_fractions", "bezier", "element_features", "sample_ele
 
 #: Sub-intervals per cubic of the arc-length table; each is integrated by Gauss–Legendre.
 _TABLE = 8
+_CHUNK = 1 << 14  # cubics per block of the arc-length table
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(3)
 _GL_X = (_GL_X + 1.0) / 2.0
 _GL_W = _GL_W / 2.0
@@ -87,6 +88,25 @@ def _partial_length(c: np.ndarray, t0: np.ndarray, t1: np.ndarray) -> np.ndarray
     return h * np.sum(_GL_W * _speed(c[..., None, :], tt), axis=-1)
 
 
+def _chord_table(cubics: np.ndarray) -> np.ndarray:
+    """Arc length of every eighth of every cubic, ``(K * T,)``, in blocks of bounded memory.
+
+    A block of :data:`_CHUNK` cubics needs about 10 MB of temporaries; one path of 10^6
+    segments computed at once needed several GiB.
+    """
+    knots = np.arange(_TABLE) / _TABLE
+    out = np.empty((cubics.shape[0], _TABLE))
+    for lo in range(0, cubics.shape[0], _CHUNK):
+        c = cubics[lo : lo + _CHUNK]
+        k = c.shape[0]
+        out[lo : lo + k] = _partial_length(
+            np.broadcast_to(c[:, None, :], (k, _TABLE, 4)),
+            np.broadcast_to(knots, (k, _TABLE)),
+            np.broadcast_to(knots + 1.0 / _TABLE, (k, _TABLE)),
+        )
+    return out.ravel()
+
+
 def sample_elements(
     elements: list[Element] | tuple[Element, ...], fractions: np.ndarray, precise: bool | np.ndarray = True
 ) -> Samples:
@@ -119,12 +139,7 @@ def sample_elements(
     length = np.zeros(n)
     if cubics.shape[0] == 0:
         return Samples(points, normals, curv, length, np.zeros((n, s), np.int64), np.zeros((n, s)))
-    knots = np.arange(_TABLE) / _TABLE
-    chords = _partial_length(
-        np.broadcast_to(cubics[:, None, :], (cubics.shape[0], _TABLE, 4)),
-        np.broadcast_to(knots, (cubics.shape[0], _TABLE)),
-        np.broadcast_to(knots + 1.0 / _TABLE, (cubics.shape[0], _TABLE)),
-    ).ravel()  # (K * T,) arc length of every sub-interval
+    chords = _chord_table(cubics)  # (K * T,) arc length of every sub-interval
     cum = np.concatenate([[0.0], np.cumsum(chords)])
     chord_owner = np.repeat(owner, _TABLE)
     first = np.searchsorted(chord_owner, np.arange(n), side="left")
