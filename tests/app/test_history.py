@@ -166,3 +166,23 @@ def test_instance_jitter_does_not_drift_along_a_sequence(window, helix_lsys, wai
     gap = np.abs(np.diff(plain)).min()
     assert drift["instance"].max() < 1e-9 * gap  # angle-only jitter turns each instance in place
     assert drift["cumulative"][-10:].mean() > gap  # a turned heading carries on along the row
+
+
+def test_opening_a_file_can_be_cancelled_and_keeps_the_open_document(window, corpus, qtbot, wait_idle):
+    """A huge file takes long to read and analyse: Cancel stops it, the open document stays."""
+    window.open_path(str(corpus("helix.svg")))
+    wait_idle(window)
+    doc = window.doc
+    text, scene, path = doc.text, doc.scene, doc.scene_path
+    tokens = _slow_inference(doc)
+    window.open_path(str(corpus("flowers.svg")))
+    qtbot.waitUntil(lambda: len(tokens) == 1, timeout=120_000)
+    assert doc.busy
+    window.inference_panel.cancel_button.click()
+    wait_idle(window)
+    assert tokens[0].cancelled
+    assert doc.text == text and doc.scene is scene and doc.scene_path == path
+    assert not doc.busy and window.is_idle()
+    window.open_path(str(corpus("flowers.svg")))  # the window is still usable: the next open works
+    wait_idle(window)
+    assert doc.scene_path is not None and doc.scene_path.endswith("flowers.svg")
