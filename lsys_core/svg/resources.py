@@ -17,7 +17,7 @@ from collections.abc import Callable
 from lsys_core.geometry.paths import ArrayPath
 from lsys_core.svg.colors import hex_of, parse_color
 from lsys_core.svg.paint import Paint, unit_value
-from lsys_core.svg.tree import Tree, href_of, local_name
+from lsys_core.svg.tree import Tree, describe, href_of, local_name, shown
 from lsys_core.svg.values import (
     IDENTITY,
     Matrix,
@@ -137,8 +137,10 @@ class Resources:
     def _chain(self, el: ET.Element, kinds: tuple[str, ...]) -> list[ET.Element] | None:
         """The element and the ones it inherits from through ``href`` (of the given kinds).
 
-        None if a reference leads nowhere, to another kind of element or back into the chain:
-        renderers then paint nothing with it.
+        None if a local reference (``#id``) leads nowhere, to another kind of element or back into
+        the chain: renderers then paint nothing with it.  A reference into another document (not
+        ``#id``) is not followed: the chain ends there and the element keeps its own attributes,
+        as renderers draw it.
         """
         out = [el]
         seen = {id(el)}
@@ -146,6 +148,11 @@ class Resources:
         while True:
             href = href_of(cur)
             if not href:
+                return out
+            if not href.startswith("#"):
+                self.notes.append(
+                    f"ignored the reference {shown(href)} of {describe(cur)}: not in this document"
+                )
                 return out
             nxt = self.tree.target(href)
             if nxt is None or id(nxt) in seen or local_name(nxt.tag) not in kinds or len(out) >= 64:

@@ -500,6 +500,25 @@ def test_gradients_are_rewritten_in_document_coordinates():
     assert first.get("gradientTransform") == "matrix(20 0 0 10 15 10)"
 
 
+@pytest.mark.parametrize(
+    ("href", "painted"),
+    [
+        ("rect1", True),  # not a local reference: not followed, the gradient keeps its own attributes
+        ("#nowhere", False),  # a local reference that leads nowhere: paints nothing
+        ("#rect1", False),  # a local reference to another kind of element: paints nothing
+    ],
+)
+def test_gradient_reference_into_another_document_is_ignored(href: str, painted: bool):
+    text = svg(
+        f'<radialGradient id="g" xlink:href="{href}"><stop offset="0" stop-color="white"/>'
+        '<stop offset="1" stop-color="black"/></radialGradient>'
+        '<rect id="rect1" x="10" y="10" width="80" height="80" fill="url(#g)"/>'
+    )
+    scene = parse_svg(text)
+    fills = [style_of(e).get("fill", "none") for e in scene.elements]
+    assert [f.startswith("url(#g-") for f in fills] == ([True] if painted else [False] * len(fills))
+
+
 def test_markers_are_expanded_into_elements():
     """A flag whose 50 stars are marker-mid instances gives 50 star elements (plus the line)."""
     points = " ".join(f"{10 + 10 * i},10" for i in range(52))
