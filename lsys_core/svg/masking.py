@@ -17,7 +17,7 @@ from lsys_core.geometry.bezier import transform_cubics
 from lsys_core.geometry.paths import d_from_cubics
 from lsys_core.svg.paint import split_url
 from lsys_core.svg.resources import Box, Resources, _box_matrix, _esc, _f
-from lsys_core.svg.tree import href_of, local_name
+from lsys_core.svg.tree import href_of, local_name, shown
 from lsys_core.svg.values import IDENTITY, Matrix, Viewport, multiply, parse_length, parse_transform, to_user
 from lsys_core.svg.verbatim import matrix_text, style_text, subtree_markup
 
@@ -42,8 +42,13 @@ class Definitions(Resources):
         key = ("clip", id(target), ctm, bbox)
         if key in self._cache:
             return self._cache[key]  # type: ignore[return-value]
-        if id(target) in self._busy:  # a clip path that clips itself: invalid, nothing is drawn
-            return EMPTY
+        if id(target) in self._busy:
+            # The reference that closes a cycle (a clip path clipped by itself, directly or through
+            # its children) is ignored, as renderers draw it: the cycle is cut there.
+            self.notes.append(
+                f"ignored the clip-path {shown(value)}: it refers back to itself (a reference cycle)"
+            )
+            return None
         self._busy.add(id(target))
         try:
             got = self._clip(target, ctm, bbox, vp)

@@ -14,6 +14,7 @@ import pytest
 from lsys_core.errors import LimitError, LsysError, SvgError
 from lsys_core.geometry import cubics_from_d, sample_cubics, sample_uniform
 from lsys_core.svg import load_svg, parse_svg
+from lsys_core.svg.tree import local_name
 
 SHARED = Path(__file__).resolve().parents[2].parent / "shared"
 NS = 'xmlns="http://www.w3.org/2000/svg"'
@@ -517,6 +518,22 @@ def test_gradient_reference_into_another_document_is_ignored(href: str, painted:
     scene = parse_svg(text)
     fills = [style_of(e).get("fill", "none") for e in scene.elements]
     assert [f.startswith("url(#g-") for f in fills] == ([True] if painted else [False] * len(fills))
+
+
+def test_clip_path_reference_closing_a_cycle_is_ignored():
+    """A clip path clipped by itself: the reference closing the cycle is cut, the shape is still clipped."""
+    star = "M 50 5 l 25 80 l -65 -50 l 80 0 l -65 50 z"
+    text = svg(
+        f'<clipPath id="c1" clip-path="url(#c1)"><path d="{star}"/></clipPath>'
+        '<rect width="100" height="100" fill="green" clip-path="url(#c1)"/>'
+    )
+    scene = parse_svg(text)
+    (rect,) = scene.elements
+    ref = style_of(rect)["clip-path"]
+    defs = ET.fromstring(f'<defs xmlns="http://www.w3.org/2000/svg">{scene.defs}</defs>')
+    (clip,) = [c for c in defs if f"url(#{c.get('id')})" == ref]
+    assert [local_name(c.tag) for c in clip] == ["path"]
+    assert any("reference cycle" in n for n in scene.warnings)
 
 
 def test_markers_are_expanded_into_elements():
