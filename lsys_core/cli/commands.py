@@ -92,7 +92,42 @@ def _read_svg(path: str):
 
     name = _name(path)
     data = read_bytes(_source(path), limit=DEFAULT_MAX_BYTES, name=name)
-    return parse_svg(data, max_bytes=DEFAULT_MAX_BYTES, name=name), read_head(data)
+    scene = parse_svg(data, max_bytes=DEFAULT_MAX_BYTES, name=name, allow_empty=True)
+    return scene, read_head(data)
+
+
+def _empty_grammar(scene):
+    """The rules of a document that draws nothing: its canvas, and an axiom rewritten to ε."""
+    from lsys_core.grammar.model import Case, Grammar, Rule, Symbol
+
+    return Grammar((), (Rule("Z", False, (Case(None, ()),)),), (Symbol("Z"),), scene.viewbox, scene.size)
+
+
+def _infer_nothing(args, scene, head, outputs: list, symmetrize: bool) -> int:
+    """Write the empty rules (and their empty drawing) of a document that draws nothing."""
+    from lsys_core.grammar import format_grammar
+
+    grammar = _empty_grammar(scene)
+    text = format_grammar(grammar)
+    drawing = _derive(grammar)
+    files: Files = []
+    if symmetrize:
+        files += _drawing_outputs(drawing, args.output, None, {}, flat=args.flat, head=head)
+        if args.rules:
+            files.append((args.rules, text))
+    else:
+        if args.output:
+            files.append((args.output, text))
+        png = getattr(args, "png", None)
+        files += _drawing_outputs(drawing, args.svg, png, _png_options(args), flat=args.flat, head=head)
+        if args.report:
+            rep = {"elements": 0, "symbols": 1, "terminals": 0, "rules": ["Z -> ε"], "axiom": "Z"}
+            rep.update(derived_elements=len(drawing), warnings=list(scene.warnings))
+            files.append((args.report, json.dumps(rep, indent=1, ensure_ascii=False) + "\n"))
+        if not args.output and not args.report and STDIO not in outputs:
+            files.append((STDIO, text))
+    _commit(files)
+    return 0
 
 
 def _load_rules(path: str):
@@ -293,6 +328,8 @@ def _cmd_infer(args, progress: Progress, say: Say, symmetrize: bool = False) -> 
     if not args.quiet:
         for w in scene.warnings:
             say(f"lsys: warning: {w}")
+    if not scene.elements:
+        return _infer_nothing(args, scene, head, outputs, symmetrize)
     fn = sym_fn if symmetrize else infer
     result = fn(scene, settings, progress=progress)
     t = time.perf_counter()

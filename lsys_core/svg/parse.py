@@ -97,8 +97,14 @@ def parse_svg(
     max_elements: int = DEFAULT_MAX_ELEMENTS,
     max_depth: int = DEFAULT_MAX_DEPTH,
     name: str = "<string>",
+    allow_empty: bool = False,
 ) -> Scene:
-    """Parse SVG text or bytes into a scene (see :func:`load_svg`); ``name`` is used in messages."""
+    """Parse SVG text or bytes into a scene (see :func:`load_svg`); ``name`` is used in messages.
+
+    A document that draws nothing (no shapes, ``display="none"`` on the root, ...) is refused
+    with :class:`SvgError`, unless ``allow_empty``: then the scene has no elements and a warning
+    says the document draws nothing.
+    """
     name = _display_name(name)
     data = source.encode("utf-8") if isinstance(source, str) else bytes(source)
     if len(data) > max_bytes:
@@ -132,7 +138,9 @@ def parse_svg(
             *_kept_messages(reader.kept),
         ]
         detail = f" ({'; '.join(reasons)})" if reasons else ""
-        raise SvgError(f"no drawable elements in {name}{detail}")
+        if not allow_empty:
+            raise SvgError(f"no drawable elements in {name}{detail}")
+        warnings.append(f"{name} draws nothing: it has no drawable elements")  # reasons: above
     verbatim = tuple(
         Verbatim(r.order, r.xml, r.what) for r in reader.records if isinstance(r, VerbatimRecord)
     )

@@ -39,6 +39,30 @@ def test_infer_writes_rules_svg_and_report(tmp_path) -> None:
     assert derived.read_text().count("<use") == 5
 
 
+@pytest.mark.parametrize(
+    "doc",
+    [
+        '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 200 100" width="20" display="none">'
+        '<rect width="9" height="9"/></svg>',
+        '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 200 100" width="20"><title>t</title></svg>',
+    ],
+    ids=["display-none-root", "no-children"],
+)
+def test_a_document_that_draws_nothing_gives_empty_rules(tmp_path, doc) -> None:
+    src, rules, out = tmp_path / "in.svg", tmp_path / "r.lsys", tmp_path / "o.svg"
+    src.write_text(doc)
+    p = run("infer", str(src), "-o", str(rules), "--svg", str(out), "--report", str(tmp_path / "r.json"))
+    assert p.returncode == 0, p.stderr
+    assert p.stderr.splitlines() == [f"lsys: warning: {src} draws nothing: it has no drawable elements"]
+    assert "rect" not in out.read_text() and "<use" not in out.read_text()
+    assert 'viewBox="0 0 200 100"' in out.read_text() and 'width="20"' in out.read_text()
+    assert json.loads((tmp_path / "r.json").read_text())["elements"] == 0
+    derived = tmp_path / "d.svg"
+    p = run("derive", str(rules), "-o", str(derived))
+    assert p.returncode == 0, p.stderr
+    assert 'viewBox="0 0 200 100"' in derived.read_text() and "<path" not in derived.read_text()
+
+
 def test_derive_set_and_randomize(tmp_path) -> None:
     rules = ROOT / "tests" / "data" / "helix_truth.lsys"
     out = tmp_path / "o.svg"

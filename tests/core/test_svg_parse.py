@@ -288,6 +288,13 @@ def test_nothing_drawable_is_an_svg_error():
         parse_svg(svg(""))
 
 
+def test_nothing_drawable_allowed_is_an_empty_scene_with_a_warning():
+    scene = parse_svg(svg('<circle r="3" transform="scale(0)"/>'), allow_empty=True, name="x.svg")
+    assert scene.elements == ()
+    assert "x.svg draws nothing: it has no drawable elements" in scene.warnings
+    assert any("degenerate" in w for w in scene.warnings)  # the reason is said too
+
+
 # ---------------------------------------------------------------------------
 # Hostile and broken input: each fails fast with the right error
 
