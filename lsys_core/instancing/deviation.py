@@ -105,21 +105,9 @@ def pose_deviations(
     out = np.zeros(n)
     if n == 0:
         return out
-    which = np.asarray(which)
-    # a shape drawn by one element is that element (the medoid of a group of one): nothing to measure
-    shared = np.bincount(which, minlength=len(shapes))[which] > 1
-    if not shared.all():
-        out[shared] = pose_deviations(
-            [e for e, keep in zip(elements, shared, strict=True) if keep],
-            shapes,
-            which[shared],
-            a[shared],
-            b[shared],
-            exact=exact,
-        )
-        return out
     el = sample_elements(elements, arc_fractions(_COARSE))
     lines = {int(s): _polyline(shapes[int(s)].cubics) for s in np.unique(which)}
+    which = np.asarray(which)
     length = np.zeros(len(shapes))
     for s, (pts, nxt) in lines.items():
         idx = np.flatnonzero(which == s)
