@@ -16,6 +16,7 @@ from functools import lru_cache
 import numpy as np
 
 from lsys_core.grammar.model import Grammar, Paint
+from lsys_core.svg.verbatim import style_text as css_text  # one writer of style text
 
 __all__ = ["css_decls", "css_text", "paint_z", "resolve_styles", "rotate_hue"]
 
@@ -39,11 +40,6 @@ def css_decls(style: str) -> dict[str, str]:
         if sep and key.strip():
             out[key.strip().lower()] = value.strip()
     return out
-
-
-def css_text(decls: dict[str, str]) -> str:
-    """Join declarations into ``"a:b;c:d"``."""
-    return ";".join(f"{k}:{v}" for k, v in decls.items())
 
 
 @lru_cache(maxsize=4096)

@@ -14,6 +14,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from lsys_core.derive.paint import css_decls as parse_style  # one splitter of style text
 from lsys_core.errors import LsysError
 
 #: In draft mode, a curve needing more lines than this is left to skia's own subdivision.
@@ -24,16 +25,6 @@ FULL_MAX_PAIRS = 8
 
 _VERB_MOVE, _VERB_LINE, _VERB_CUBIC, _VERB_CLOSE = 0, 1, 4, 5
 _BUCKETS_PER_OCTAVE = 4  # draft mode groups instances by scale in quarter octaves
-
-
-def parse_style(style: str) -> dict[str, str]:
-    """Split CSS declarations ``"a:b;c:d"`` into a dict with lower-case keys."""
-    out: dict[str, str] = {}
-    for part in style.split(";"):
-        key, sep, value = part.partition(":")
-        if sep:
-            out[key.strip().lower()] = value.strip()
-    return out
 
 
 def _number(text: str | None, default: float) -> float:
