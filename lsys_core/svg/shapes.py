@@ -110,11 +110,11 @@ def tight_bbox(cubics: np.ndarray) -> tuple[float, float, float, float] | None:
     ext = [cubics[:, 0], cubics[:, 3]]
     for part in (cubics.real, cubics.imag):
         p0, p1, p2, p3 = part.T
-        # Derivative / 3 = a t^2 + b t + c.
-        a = -p0 + 3 * p1 - 3 * p2 + p3
-        b = 2 * (p0 - 2 * p1 + p2)
-        c = p1 - p0
-        with np.errstate(invalid="ignore", divide="ignore"):
+        # Derivative / 3 = a t^2 + b t + c (huge coordinates may overflow: skipped later as such)
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            a = -p0 + 3 * p1 - 3 * p2 + p3
+            b = 2 * (p0 - 2 * p1 + p2)
+            c = p1 - p0
             disc = np.sqrt(np.maximum(b * b - 4 * a * c, 0.0))
             lin = np.abs(a) < 1e-12 * (np.abs(b) + np.abs(c) + 1e-300)
             t1 = np.where(lin, -c / b, (-b + disc) / (2 * a))
@@ -226,6 +226,7 @@ def shape_geometry(
             values = values[:-1]
         if values.size < 4:
             return None, "degenerate (zero size)"
-        pts = values[0::2] + 1j * values[1::2]
+        pts = np.empty(values.size // 2, complex)  # (1j * inf would warn: non-finite points are
+        pts.real, pts.imag = values[0::2], values[1::2]  # skipped later, as in path data)
     table = polyline_table(pts, closed=tag == "polygon")
     return Geometry(ArrayPath(*cubics_from_table(table)), table), None
