@@ -20,8 +20,9 @@ import numpy as np
 from lsys_core.geometry import pathdata as pd
 from lsys_core.geometry.pathdata import PathTable
 from lsys_core.svg.paint import length, split_url
+from lsys_core.svg.records import length_or
 from lsys_core.svg.tree import local_name
-from lsys_core.svg.values import Viewport, multiply, parse_length, parse_viewbox, to_user, viewbox_transform
+from lsys_core.svg.values import Viewport, multiply, parse_viewbox, viewbox_transform
 
 if TYPE_CHECKING:
     from lsys_core.svg.walk import Ctx, Reader
@@ -221,8 +222,8 @@ def _instance(
     from lsys_core.svg import group_effects
 
     mstyle = reader.style_at(marker)
-    mw = _attr_length(marker.get("markerWidth"), ctx.vp, "x", 3.0)
-    mh = _attr_length(marker.get("markerHeight"), ctx.vp, "y", 3.0)
+    mw = length_or(marker.get("markerWidth"), ctx.vp, "x", 3.0)
+    mh = length_or(marker.get("markerHeight"), ctx.vp, "y", 3.0)
     if mw <= 0 or mh <= 0:
         return
     angle = orient_angle(marker.get("orient"), mp.kind, mp.angle) or 0.0
@@ -239,8 +240,8 @@ def _instance(
     else:
         content_vp = Viewport(mw, mh, ctx.vp.font_size, ctx.vp.root_font_size)
         clip_box = (0.0, 0.0, mw, mh)
-    rx = _attr_length(marker.get("refX"), content_vp, "x", 0.0)
-    ry = _attr_length(marker.get("refY"), content_vp, "y", 0.0)
+    rx = length_or(marker.get("refX"), content_vp, "x", 0.0)
+    ry = length_or(marker.get("refY"), content_vp, "y", 0.0)
     m = multiply(m, (1.0, 0.0, 0.0, 1.0, -rx, -ry))
     clip = None
     if mstyle.get("overflow", "hidden").strip().lower() in ("hidden", "scroll"):
@@ -266,11 +267,3 @@ def _instance(
             reader.walk(child, inner)
     if len(reader.records) > start:
         group_effects.apply(reader, marker, {"opacity": mstyle.get("opacity", "1")}, inner, start, clip)
-
-
-def _attr_length(text: str | None, vp: Viewport, axis: str, default: float) -> float:
-    got = parse_length(text) if text is not None else None
-    if got is None:
-        return default
-    v = to_user(got, vp, axis)
-    return v if math.isfinite(v) else default
