@@ -36,6 +36,7 @@ import numpy as np
 from lsys_core.derive.model import Drawing
 from lsys_core.errors import LsysError
 from lsys_core.io import write_atomic
+from lsys_core.render.kept import Kept
 from lsys_core.render.passes import (
     DRAFT_CHUNK,
     DRAFT_TOLERANCE,
@@ -185,9 +186,13 @@ class Renderer:
         canvas.resetMatrix()
         canvas.clear(skia.ColorSetARGB(a, r, g, b))
         n = len(drawing)
-        if n == 0:
+        kept = Kept(drawing)
+        if n == 0 and not kept:
             return self._pixels
         s, tx, ty = fit_view(view if view is not None else default_view(drawing), width, height)
+        if n == 0:
+            kept.draw(canvas, None, (s, tx, ty))
+            return self._pixels
         symbol, terms = self._pairs(drawing)
         sscale = drawing.stroke_scale()
         pa = np.asarray(drawing.a, dtype=complex).reshape(n)
@@ -197,10 +202,12 @@ class Renderer:
             da = s * pa
             db = s * pb + complex(tx, ty)
         visible = self._visible(terms, symbol, da, db, sscale, width, height)
-        if draft:
+        if draft:  # kept content placed before every instance goes under them, the rest on top
+            kept.draw(canvas, np.flatnonzero(kept.orders == 0).tolist(), (s, tx, ty))
             self._draw_batched(terms, symbol, da, db, sscale, visible)
+            kept.draw(canvas, np.flatnonzero(kept.orders > 0).tolist(), (s, tx, ty))
         else:
-            self._draw_each(terms, symbol, da, db, sscale, visible, antialias)
+            self._draw_each(terms, symbol, da, db, sscale, visible, antialias, kept, (s, tx, ty))
         if highlight is not None:
             mask = np.zeros(n, dtype=bool)
             hl = np.asarray(highlight).reshape(-1)
@@ -247,25 +254,26 @@ class Renderer:
             ok = (x + rr >= 0) & (x - rr <= width) & (y + rr >= 0) & (y - rr <= height)
         return ok & ~empty[sym] & np.isfinite(rr) & np.isfinite(db)
 
-    def _draw_each(self, terms, symbol, da, db, sscale, visible, antialias: bool) -> None:
+    def _draw_each(self, terms, symbol, da, db, sscale, visible, antialias: bool, kept, view) -> None:
         """Draw the visible instances in order: one by one, or in batches where that is the same.
 
         Runs of at least :data:`FULL_MIN_RUN` consecutive instances whose painted rectangles
         are pairwise disjoint cover no pixel twice (except anti-aliased edge pixels of touching
         instances), so drawing them terminal by terminal as batched paths gives the same picture
         (such shared edge pixels blend as in one shape, without a seam); the rest is drawn one
-        by one, each instance with its own matrix.
+        by one, each instance with its own matrix.  Kept content (text, images) is drawn at
+        its place among them (:class:`~lsys_core.render.kept.Kept`).
         """
         idx = np.flatnonzero(visible)
-        if idx.size == 0:
-            return
         full = _FullPass(self._canvas, terms, symbol[idx], da[idx], db[idx], antialias, sscale[idx])
-        done = 0
-        for lo, hi in full.compact_runs():
-            full.one_by_one(range(done, lo))
-            full.run(lo, hi)
-            done = hi
-        full.one_by_one(range(done, idx.size))
+        runs = full.compact_runs() if idx.size else []
+        for kind, lo, hi, items in kept.steps(idx, runs):
+            if kind == "each":
+                full.one_by_one(range(lo, hi))
+            elif kind == "run":
+                full.run(lo, hi)
+            else:
+                kept.draw(self._canvas, items, view)
 
     def _draw_batched(self, terms, symbol, da, db, sscale, visible) -> None:
         """Draft: per terminal and scale bucket, chunks of instances drawn as one path each."""

@@ -1,0 +1,125 @@
+"""Styles of kept content for the own renderer: cascade down a kept fragment, paints, transforms.
+
+A kept fragment (:class:`~lsys_core.grammar.model.Verbatim`) has its cascaded declarations
+baked into ``style`` attributes by the reader, so computing an element's style here is only
+inheritance: the parent's inherited properties, then the element's presentation attributes,
+then its ``style`` declarations (``inherit`` takes the parent's value).  ``font-size`` is
+resolved to user units on the way down, so ``em`` and ``%`` sizes of nested ``<tspan>``
+elements refer to their parent's size.  skia is imported inside the functions.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from collections.abc import Mapping
+
+from lsys_core.render.paths import _number, _Paints, _rgba, _skia_paint, parse_style
+from lsys_core.svg.style import INHERITED, PROPERTIES, font_size_px
+from lsys_core.svg.values import IDENTITY, Matrix, Viewport, parse_length, parse_transform, to_user
+
+__all__ = ["computed", "font_px", "group_opacity", "lengths", "shape_paints", "transform_of"]
+
+#: The initial font size in user units (librsvg's; CSS's ``medium`` would be 16).
+INITIAL_FONT_SIZE = 12.0
+#: Presentation attributes read from a kept element (``transform`` is read by :func:`transform_of`).
+_ATTRIBUTES = PROPERTIES - {"transform", "font"}
+
+
+def computed(parent: Mapping[str, str], el: ET.Element) -> dict[str, str]:
+    """Return an element's computed declarations given its parent's (``font-size`` as a number)."""
+    own = {k: v for k, v in el.attrib.items() if k in _ATTRIBUTES}
+    own.update(parse_style(el.get("style", "")))
+    out = {k: v for k, v in parent.items() if k in INHERITED}
+    parent_px = font_px(parent)
+    for k, v in own.items():
+        if v.strip().lower() == "inherit":
+            if k in parent:
+                out[k] = parent[k]
+            else:
+                out.pop(k, None)
+        else:
+            out[k] = v
+    if "font-size" in own:
+        size = font_size_px(out.get("font-size", ""), parent_px, INITIAL_FONT_SIZE)
+        out["font-size"] = repr(size if math.isfinite(size) and size >= 0 else parent_px)
+    return out
+
+
+def font_px(style: Mapping[str, str]) -> float:
+    """The font size of a computed style in user units."""
+    return _number(style.get("font-size"), INITIAL_FONT_SIZE)
+
+
+def lengths(
+    text: str | None, style: Mapping[str, str], viewport: tuple[float, float], axis: str = "o"
+) -> list[float] | None:
+    """Read a list of lengths in user units (font-relative ones of ``style``, percentages of the
+    ``viewport`` size along ``axis``); None when absent, empty or unreadable."""
+    if text is None:
+        return None
+    vp = Viewport(viewport[0], viewport[1], font_px(style), INITIAL_FONT_SIZE)
+    out = []
+    for part in text.replace(",", " ").split():
+        length = parse_length(part)
+        if length is None:
+            return None
+        out.append(to_user(length, vp, axis))
+    return out or None
+
+
+def transform_of(el: ET.Element, style: Mapping[str, str]) -> Matrix | None:
+    """Return an element's own transform (the CSS property wins over the attribute); None if unreadable."""
+    if "transform" in style:
+        return parse_transform(style["transform"], css=True)
+    if el.get("transform") is not None:
+        return parse_transform(el.get("transform"))
+    return IDENTITY
+
+
+def group_opacity(style: Mapping[str, str]) -> float:
+    """The element's ``opacity`` (a group effect, not inherited), clamped to [0, 1]."""
+    return max(0.0, min(1.0, _number(style.get("opacity"), 1.0)))
+
+
+def _colour(style: Mapping[str, str], key: str, default: str, opacity_key: str):
+    value = style.get(key, default).strip()
+    if value.lower().startswith("url("):
+        # A paint server the own renderer does not draw: its fallback colour, if any.
+        close = value.find(")")
+        value = value[close + 1 :].strip() if close >= 0 else ""
+        if not value:
+            return None
+    if value.lower() == "currentcolor":
+        value = style.get("color", "black")
+    opacity = max(0.0, min(1.0, _number(style.get(opacity_key), 1.0)))
+    rgba = _rgba(value, opacity)
+    return rgba if rgba is not None and rgba[3] > 0 else None
+
+
+def shape_paints(style: Mapping[str, str], antialias: bool = True) -> list:
+    """Return the skia paints of a shape with this style, in its paint order (fill, stroke)."""
+    fill = _colour(style, "fill", "black", "fill-opacity")
+    stroke = _colour(style, "stroke", "none", "stroke-opacity")
+    width = max(0.0, _number(style.get("stroke-width"), 1.0))
+    if width == 0.0 or not math.isfinite(width):
+        stroke = None
+    paints = _Paints(
+        fill=fill,
+        stroke=stroke,
+        width=width,
+        cap=style.get("stroke-linecap", "butt").lower(),
+        join=style.get("stroke-linejoin", "miter").lower(),
+        miter=max(1.0, _number(style.get("stroke-miterlimit"), 4.0)),
+        evenodd=False,
+    )
+    out = []
+    if fill is not None:
+        out.append(_skia_paint(fill, antialias))
+    if stroke is not None:
+        out.append(_skia_paint(stroke, antialias, paints, width))
+    order = style.get("paint-order", "normal").split()
+    stroke_first = order[:1] == ["stroke"] or order[:2] == ["markers", "stroke"]
+    if stroke_first and len(out) == 2:
+        out.reverse()
+    return out
