@@ -92,7 +92,7 @@ class Kept:
         for k, p in enumerate(pos):
             cuts.setdefault(int(p), []).append(k)
         done = 0
-        for p in [*sorted(cuts), int(idx.size)]:
+        for p in sorted({*cuts, int(idx.size)}):
             for lo, hi in runs:
                 lo, hi = max(lo, done), min(hi, p)
                 if lo < hi:
