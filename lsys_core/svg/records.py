@@ -20,6 +20,7 @@ __all__ = [
     "box_of",
     "length_or",
     "only_part",
+    "paint_order",
     "source_names",
     "switch_child",
 ]
@@ -73,6 +74,18 @@ def only_part(decls: dict[str, str], part: str) -> dict[str, str]:
         out["fill"] = "none"
     out.pop("paint-order", None)
     return out
+
+
+def paint_order(value: str | None) -> list[str]:
+    """The full painting order of a ``paint-order`` value: ``fill``, ``stroke``, ``markers`` in some order.
+
+    Keywords left out follow the given ones in their default order (``markers stroke`` paints
+    the markers, then the stroke, then the fill).
+    """
+    words = (value or "normal").split()
+    if words == ["normal"]:
+        words = []
+    return words + [w for w in ("fill", "stroke", "markers") if w not in words]
 
 
 def box_of(path: ArrayPath) -> tuple[float, float, float, float] | None:

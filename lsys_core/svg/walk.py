@@ -38,6 +38,7 @@ from lsys_core.svg.records import (
     box_of,
     length_or,
     only_part,
+    paint_order,
     source_names,
     switch_child,
 )
@@ -319,14 +320,14 @@ class Reader:
         if stroked and anisotropy(ctx.ctm) > 1.02:
             self.keep_as_is(el, outer, "stroke under a non-uniform scale")
             return
-        order = style.get("paint-order", "normal").split()
+        order = paint_order(style.get("paint-order"))
         marks = self._markers_wanted(tag, style, geom)
-        markers_first = "markers" in order and (order.index("markers") == 0)
+        markers_first = order[0] == "markers"
         if marks and markers_first:
             self._markers(el, geom, ctx, decls)
         if not empty:
             source = ctx.chain + self._names.get(id(el), tag)
-            if marks and "markers" in order and order.index("markers") == 1:
+            if marks and order[1] == "markers":
                 # Markers between fill and stroke: the element is drawn in two parts.
                 first, second = order[0], next(w for w in ("fill", "stroke") if w != order[0])
                 self._add_shape(geom.path, ctx.ctm, only_part(decls, first), source)
@@ -368,8 +369,8 @@ class Reader:
         opacity = unit_value(style.get("opacity"), 1.0)
         if opacity < 1.0:
             decls["opacity"] = f"{opacity:.6g}"
-        order = style.get("paint-order", "normal").split()
-        if order and order != ["normal"] and order[0] == "stroke":
+        order = paint_order(style.get("paint-order"))
+        if order.index("stroke") < order.index("fill"):
             decls["paint-order"] = "stroke"
         clip = self.resources.clip(style.get("clip-path"), ctm, box, vp)
         if clip == EMPTY:
