@@ -24,6 +24,7 @@ from lsys_core.svg.values import Viewport, parse_length, to_user
 __all__ = [
     "Geometry",
     "KeepAsIs",
+    "draws_cap_dots",
     "ellipse_path",
     "polyline_table",
     "rect_path",
@@ -157,6 +158,29 @@ def _len(el: ET.Element, name: str, vp: Viewport, axis: str, default: float | No
     if got.unit in UNCERTAIN_UNITS:
         raise KeepAsIs(f"{got.unit} units")
     return to_user(got, vp, axis)
+
+
+def draws_cap_dots(style: dict[str, str], table: PathTable | None) -> bool:
+    """Whether a stroke draws caps on a zero-length subpath (a dot or a square where it stands).
+
+    SVG 2 strokes a subpath whose segments all have zero length when ``stroke-linecap`` is
+    ``round`` or ``square``; the cubic geometry drops such segments, so the caller keeps the
+    element as it is.
+    """
+    if table is None or table.op.size == 0 or style.get("stroke", "none").strip().lower() == "none":
+        return False
+    if style.get("stroke-linecap", "butt").strip().lower() not in ("round", "square"):
+        return False
+    op, pts = table.op, table.pts
+    is_move = op == pd.MOVE
+    after_close = np.zeros(op.size, dtype=bool)
+    after_close[1:] = op[:-1] == pd.CLOSE
+    sub = np.cumsum(is_move | after_close) - 1
+    zero = (pts == pts[:, :1]).all(axis=1)
+    drawing = ~is_move & (sub >= 0)
+    n_draw = np.bincount(sub[drawing], minlength=int(sub.max()) + 1)
+    n_long = np.bincount(sub[drawing & ~zero], minlength=n_draw.size)
+    return bool(np.any((n_draw > 0) & (n_long == 0)))
 
 
 class Geometry(NamedTuple):

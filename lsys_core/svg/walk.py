@@ -42,7 +42,7 @@ from lsys_core.svg.records import (
     source_names,
     switch_child,
 )
-from lsys_core.svg.shapes import Geometry, KeepAsIs, shape_geometry
+from lsys_core.svg.shapes import Geometry, KeepAsIs, draws_cap_dots, shape_geometry
 from lsys_core.svg.style import DEFAULT_FONT_SIZE, Cascade
 from lsys_core.svg.tree import Tree, describe, href_of, local_name, shown
 from lsys_core.svg.values import (
@@ -307,6 +307,9 @@ class Reader:
             self.skips[reason or "degenerate (zero size)"] += 1
             return
         if style.get("visibility", "visible").strip().lower() != "visible":
+            return
+        if draws_cap_dots(style, geom.table):
+            self.keep_as_is(el, outer, "zero-length subpath with caps")
             return
         empty = geom.path.cubics.shape[0] == 0
         if empty and not self._markers_wanted(tag, style, geom):
