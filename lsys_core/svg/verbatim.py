@@ -14,7 +14,7 @@ from collections.abc import Callable
 
 from lsys_core.svg.style import INHERITED
 from lsys_core.svg.tree import XLINK_HREF, local_name
-from lsys_core.svg.values import IDENTITY, Matrix
+from lsys_core.svg.values import IDENTITY, Matrix, parse_transform
 
 __all__ = ["matrix_text", "references", "style_text", "subtree_markup", "wrap"]
 
@@ -73,8 +73,16 @@ def _copy(el, specified, on_reference, keep_id, budget) -> ET.Element:
     new_tag = tag if tag is not None else el.tag
     out = ET.Element(new_tag)
     decls = specified(el) if tag is not None else {}
+    own_transform = "transform" in decls
+    if own_transform:
+        # Written as the attribute (renderers differ on the CSS property), in matrix form, which
+        # reads the same in both syntaxes; an unreadable transform is left out, as it is ignored.
+        decls = dict(decls)
+        m = parse_transform(decls.pop("transform"), css=True)
+        if m is not None and m != IDENTITY:
+            out.set("transform", matrix_text(m))
     for k, v in el.attrib.items():
-        if k == "style" or k in decls:
+        if k == "style" or k in decls or (k == "transform" and own_transform):
             continue
         if k == XLINK_HREF:
             k = "href"

@@ -6,6 +6,10 @@ draw) and checks the scene the reader makes of a small document.
 
 from __future__ import annotations
 
+import re
+
+import pytest
+
 from lsys_core.svg import parse_svg
 
 NS = 'xmlns="http://www.w3.org/2000/svg"'
@@ -34,3 +38,29 @@ def test_paint_order_keywords_left_out_follow_in_default_order():
     # the default order keeps fill under stroke: no paint-order written
     (plain,) = parse_svg(svg('<path d="M0 0 L9 9" stroke="blue" paint-order="fill"/>')).elements
     assert "paint-order" not in style_of(plain)
+
+
+def test_zero_length_subpath_with_caps_is_kept_as_is():
+    """A round or square cap on a zero-length subpath draws a dot: the element is kept as it is."""
+    dots = 'd="M 10 10 L 10 10" stroke="green" stroke-width="4"'
+    scene = parse_svg(svg(f'<path {dots} stroke-linecap="round"/><rect width="5" height="5"/>'))
+    (kept,) = scene.verbatim
+    assert 'd="M 10 10 L 10 10"' in kept.xml and "stroke-linecap:round" in kept.xml
+    # a longer path with one zero-length subpath keeps its dot too
+    mixed = '<path d="M 0 0 L 50 0 M 70 70 L 70 70" stroke="green" stroke-linecap="square"/>'
+    assert len(parse_svg(svg(mixed + '<rect width="5" height="5"/>')).verbatim) == 1
+    # butt caps draw nothing there: skipped as before, nothing kept
+    scene = parse_svg(svg(f'<path {dots}/><rect width="5" height="5"/>'))
+    assert not scene.verbatim and len(scene.elements) == 1
+    # a line of zero length is the same
+    line = '<line x1="5" y1="5" x2="5" y2="5" stroke="red" stroke-linecap="round"/>'
+    assert len(parse_svg(svg(line + '<rect width="5" height="5"/>')).verbatim) == 1
+
+
+def test_kept_content_writes_its_transform_as_the_attribute():
+    """A kept element's own transform stays an attribute (renderers ignore it as a CSS property)."""
+    text = svg('<text x="0" y="20" transform="translate(20 60) rotate(90)" font-size="10">Hi</text>')
+    (kept,) = parse_svg(text, allow_empty=True).verbatim
+    got = re.search(r'<text[^>]* transform="matrix\(([^)]*)\)"', kept.xml)
+    assert got is not None and "transform:" not in kept.xml
+    assert [float(v) for v in got.group(1).split()] == pytest.approx([0, 1, -1, 0, 20, 60], abs=1e-9)
