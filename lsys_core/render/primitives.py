@@ -5,7 +5,7 @@ cubics).  For the structured export a terminal whose path *is* a circle, an elli
 rectangle or a straight line is written as that element again, so a designer sees (and can
 edit) the element they drew.  :func:`primitive` decides from the geometry alone:
 
-- a line: one open subpath of one straight segment;
+- a line: one open subpath of one straight segment that leaves and arrives along its chord;
 - a rectangle: one closed subpath of four straight sides at right angles (rotated ones get a
   ``transform="rotate(…)"``), or of four straight sides joined by quarter circles or quarter
   ellipses (a rounded rectangle: ``rx``, ``ry``);
@@ -54,6 +54,22 @@ def _straight(cubics: np.ndarray, tol: float) -> np.ndarray:
     return (length > 0) & (off <= tol) & inside
 
 
+def _ends_along_chord(seg: np.ndarray, max_angle: float = 1e-3) -> bool:
+    """Whether a straight cubic leaves and arrives along its chord (line caps keep their direction).
+
+    A control point a hair off the chord, next to its end point, turns the end's tangent (and so a
+    stroke's cap) far from the chord's direction although the curve stays within the tolerance.
+    """
+    chord = seg[3] - seg[0]
+    for tangent in (
+        next((seg[k] - seg[0] for k in (1, 2, 3) if seg[k] != seg[0]), chord),
+        next((seg[3] - seg[k] for k in (2, 1, 0) if seg[k] != seg[3]), chord),
+    ):
+        if abs(np.angle(tangent / chord)) > max_angle:
+            return False
+    return True
+
+
 def primitive(d: str) -> tuple[str, dict[str, str]] | None:
     """Return ``(tag, attributes)`` of a basic SVG element drawing the same shape as path data ``d``.
 
@@ -88,7 +104,7 @@ def primitive(d: str) -> tuple[str, dict[str, str]] | None:
     tol = TOLERANCE * size
     straight = _straight(cubics, tol)
     if not closed[0]:
-        if cubics.shape[0] == 1 and straight[0]:
+        if cubics.shape[0] == 1 and straight[0] and _ends_along_chord(cubics[0]):
             (p, q) = cubics[0, 0], cubics[0, 3]
             return "line", {"x1": _num(p.real), "y1": _num(p.imag), "x2": _num(q.real), "y2": _num(q.imag)}
         return None

@@ -122,3 +122,13 @@ def test_recognised_shapes_match_the_path(d, tag) -> None:
 )
 def test_other_shapes_keep_their_path(d) -> None:
     assert primitive(d) is None
+
+
+def test_near_straight_curve_leaving_off_its_chord_is_not_a_line() -> None:
+    """Within the tolerance of its chord, yet its ends leave sideways: a stroke's caps would turn."""
+    assert primitive("M 20 160 C 20.1 160 160 20 160.1 20") is None
+    assert primitive("M 20 160 C 60 120 120 60 160 20") == (
+        "line",
+        {"x1": "20", "y1": "160", "x2": "160", "y2": "20"},
+    )
+    assert primitive("M 0 0 C 0 0 3 3 3 3") is not None  # control points on the ends: along the chord
