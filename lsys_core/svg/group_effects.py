@@ -71,6 +71,8 @@ def apply(
     clip = res.intersect(own, clip)
     for rec in reader.records[start:]:
         if isinstance(rec, ShapeRecord):
+            if rec.hidden:
+                continue
             st = rec.style
             if opacity < 1.0:
                 st["opacity"] = f"{unit_value(st.get('opacity'), 1.0) * opacity:.6g}"

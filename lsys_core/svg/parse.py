@@ -197,7 +197,9 @@ def _root_context(reader: Reader, root) -> tuple:
 def _elements(reader: Reader) -> tuple[list[Element], Counter]:
     """Transform the shape records into elements (one vectorised pass) and drop unusable ones."""
     skips: Counter = Counter(reader.skips)
-    recs = [r for r in reader.records if isinstance(r, ShapeRecord) and r.path.cubics.shape[0]]
+    recs = [
+        r for r in reader.records if isinstance(r, ShapeRecord) and r.path.cubics.shape[0] and not r.hidden
+    ]
     if not recs:
         return [], skips
     counts = np.fromiter((r.path.cubics.shape[0] for r in recs), dtype=np.intp, count=len(recs))

@@ -30,13 +30,18 @@ SHAPES = frozenset({"path", "rect", "circle", "ellipse", "line", "polyline", "po
 
 @dataclass
 class ShapeRecord:
-    """A drawable shape: geometry in its own coordinates, its matrix to document coordinates."""
+    """A drawable shape: geometry in its own coordinates, its matrix to document coordinates.
+
+    A ``hidden`` shape (``visibility`` other than ``visible``) draws nothing and becomes no
+    element, but it is part of its groups' bounding boxes (``objectBoundingBox`` units).
+    """
 
     path: ArrayPath
     ctm: Matrix
     style: dict[str, str]
     source: str
     order: int
+    hidden: bool = False
 
 
 @dataclass

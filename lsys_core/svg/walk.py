@@ -20,15 +20,9 @@ from lsys_core.errors import LimitError
 from lsys_core.geometry.paths import ArrayPath
 from lsys_core.svg import group_effects, markers
 from lsys_core.svg.css import StyleSheet
-from lsys_core.svg.masking import EMPTY, Definitions
-from lsys_core.svg.paint import (
-    anisotropy,
-    paint_declarations,
-    parse_paint,
-    scale_of,
-    stroke_declarations,
-    unit_value,
-)
+from lsys_core.svg.declare import shape_declarations
+from lsys_core.svg.masking import Definitions
+from lsys_core.svg.paint import anisotropy
 from lsys_core.svg.pathcache import DEFAULT_MAX_SEGMENTS, PathCache
 from lsys_core.svg.records import (
     SHAPES,
@@ -307,6 +301,8 @@ class Reader:
             self.skips[reason or "degenerate (zero size)"] += 1
             return
         if style.get("visibility", "visible").strip().lower() != "visible":
+            if geom.path.cubics.shape[0]:  # draws nothing, yet counts in its groups' boxes
+                self.records.append(ShapeRecord(geom.path, ctx.ctm, {}, "", -1, hidden=True))
             return
         if draws_cap_dots(style, geom.table):
             self.keep_as_is(el, outer, "zero-length subpath with caps")
@@ -316,7 +312,7 @@ class Reader:
             self.skips[reason or "degenerate (zero size)"] += 1
             return
         box = box_of(geom.path)
-        decls = self._paint(style, ctx, box)
+        decls = shape_declarations(self.resources, style, ctx, box)
         if decls is None:
             return  # clipped out entirely
         stroked = decls.get("stroke", "none") != "none"
@@ -346,46 +342,6 @@ class Reader:
         if self.segments > DEFAULT_MAX_SEGMENTS:
             raise LimitError(f"{self.name} draws more than {DEFAULT_MAX_SEGMENTS:,} path segments")
         self.records.append(ShapeRecord(path, ctm, decls, source, self._next_order()))
-
-    def _paint(self, style: dict[str, str], ctx: Ctx, box) -> dict[str, str] | None:
-        """The declarations a shape draws with (None: clipped out or masked out entirely)."""
-        ctm, vp = ctx.ctm, ctx.vp
-
-        def server(ref: str):
-            return self.resources.paint_server(ref, ctm, box, vp)
-
-        fill = parse_paint(style.get("fill", "black"), style, server, ctx.context)
-        stroke = parse_paint(style.get("stroke", "none"), style, server, ctx.context)
-        geometry_decls = None
-        if stroke is not None:
-            vector_effect = style.get("vector-effect", "none").strip().lower()
-            scale = 1.0 if vector_effect == "non-scaling-stroke" else scale_of(ctm)
-            geometry_decls = stroke_declarations(style, vp, scale)
-            if geometry_decls is None:
-                stroke = None
-        decls = paint_declarations("fill", fill, unit_value(style.get("fill-opacity"), 1.0))
-        if fill is not None and style.get("fill-rule", "nonzero").strip().lower() == "evenodd":
-            decls["fill-rule"] = "evenodd"
-        decls.update(paint_declarations("stroke", stroke, unit_value(style.get("stroke-opacity"), 1.0)))
-        if geometry_decls:
-            decls.update(geometry_decls)
-        opacity = unit_value(style.get("opacity"), 1.0)
-        if opacity < 1.0:
-            decls["opacity"] = f"{opacity:.6g}"
-        order = paint_order(style.get("paint-order"))
-        if order.index("stroke") < order.index("fill"):
-            decls["paint-order"] = "stroke"
-        clip = self.resources.clip(style.get("clip-path"), ctm, box, vp)
-        if clip == EMPTY:
-            return None
-        if clip:
-            decls["clip-path"] = f"url(#{clip})"
-        mask = self.resources.mask(style.get("mask"), ctm, box, vp)
-        if mask == EMPTY:
-            return None
-        if mask:
-            decls["mask"] = f"url(#{mask})"
-        return decls
 
     # -- markers --------------------------------------------------------------------------------
 

@@ -7,9 +7,11 @@ draw) and checks the scene the reader makes of a small document.
 from __future__ import annotations
 
 import re
+import xml.etree.ElementTree as ET
 
 import pytest
 
+from lsys_core.geometry import cubics_from_d
 from lsys_core.svg import parse_svg
 
 NS = 'xmlns="http://www.w3.org/2000/svg"'
@@ -64,3 +66,19 @@ def test_kept_content_writes_its_transform_as_the_attribute():
     got = re.search(r'<text[^>]* transform="matrix\(([^)]*)\)"', kept.xml)
     assert got is not None and "transform:" not in kept.xml
     assert [float(v) for v in got.group(1).split()] == pytest.approx([0, 1, -1, 0, 20, 60], abs=1e-9)
+
+
+def test_hidden_shapes_count_in_a_group_bounding_box():
+    """``visibility: hidden`` draws nothing but the shape is part of its group's bounding box."""
+    text = svg(
+        '<clipPath id="c" clipPathUnits="objectBoundingBox"><rect width="0.5" height="1"/></clipPath>'
+        '<g clip-path="url(#c)"><rect x="0" y="0" width="100" height="100" visibility="hidden"/>'
+        '<rect x="25" y="25" width="50" height="50"/></g>'
+    )
+    scene = parse_svg(text)
+    (el,) = scene.elements
+    ref = style_of(el)["clip-path"]
+    defs = ET.fromstring(f'<defs xmlns="http://www.w3.org/2000/svg">{scene.defs}</defs>')
+    (clip,) = [c for c in defs if "url(#" + c.get("id") + ")" == ref]
+    c, _, _ = cubics_from_d(clip[0].get("d"))
+    assert (c.real.min(), c.real.max(), c.imag.min(), c.imag.max()) == pytest.approx((0, 50, 0, 100))

@@ -1,0 +1,62 @@
+"""The declarations a shape draws with: paints, stroke geometry, opacity, paint order, clip, mask.
+
+A shape's computed style becomes the few declarations the scene keeps, in document units: paint
+server references are rewritten for the element (:meth:`.resources.Resources.paint_server`),
+stroke lengths are scaled by its transform, and clip paths and masks are rewritten in document
+coordinates (:class:`.masking.Definitions`).
+"""
+
+from __future__ import annotations
+
+from lsys_core.svg.masking import EMPTY, Definitions
+from lsys_core.svg.paint import paint_declarations, parse_paint, scale_of, stroke_declarations, unit_value
+from lsys_core.svg.records import Ctx, paint_order
+from lsys_core.svg.resources import Box
+
+__all__ = ["shape_declarations"]
+
+
+def shape_declarations(
+    defs: Definitions, style: dict[str, str], ctx: Ctx, box: Box | None
+) -> dict[str, str] | None:
+    """The declarations a shape draws with (None: clipped out or masked out entirely).
+
+    ``box`` is the shape's bounding box in its own coordinates (for ``objectBoundingBox`` units).
+    """
+    ctm, vp = ctx.ctm, ctx.vp
+
+    def server(ref: str):
+        return defs.paint_server(ref, ctm, box, vp)
+
+    fill = parse_paint(style.get("fill", "black"), style, server, ctx.context)
+    stroke = parse_paint(style.get("stroke", "none"), style, server, ctx.context)
+    geometry_decls = None
+    if stroke is not None:
+        vector_effect = style.get("vector-effect", "none").strip().lower()
+        scale = 1.0 if vector_effect == "non-scaling-stroke" else scale_of(ctm)
+        geometry_decls = stroke_declarations(style, vp, scale)
+        if geometry_decls is None:
+            stroke = None
+    decls = paint_declarations("fill", fill, unit_value(style.get("fill-opacity"), 1.0))
+    if fill is not None and style.get("fill-rule", "nonzero").strip().lower() == "evenodd":
+        decls["fill-rule"] = "evenodd"
+    decls.update(paint_declarations("stroke", stroke, unit_value(style.get("stroke-opacity"), 1.0)))
+    if geometry_decls:
+        decls.update(geometry_decls)
+    opacity = unit_value(style.get("opacity"), 1.0)
+    if opacity < 1.0:
+        decls["opacity"] = f"{opacity:.6g}"
+    order = paint_order(style.get("paint-order"))
+    if order.index("stroke") < order.index("fill"):
+        decls["paint-order"] = "stroke"
+    clip = defs.clip(style.get("clip-path"), ctm, box, vp)
+    if clip == EMPTY:
+        return None
+    if clip:
+        decls["clip-path"] = f"url(#{clip})"
+    mask = defs.mask(style.get("mask"), ctm, box, vp)
+    if mask == EMPTY:
+        return None
+    if mask:
+        decls["mask"] = f"url(#{mask})"
+    return decls
