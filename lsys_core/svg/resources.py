@@ -171,7 +171,7 @@ class Resources:
                 return v
         return None
 
-    def _gradient(self, el: ET.Element, tag: str, ctm: Matrix, bbox: Box | None, vp: Viewport) -> Paint:
+    def _gradient(self, el: ET.Element, tag: str, ctm: Matrix, bbox: Box | None, vp: Viewport) -> Paint | str:
         chain = self._chain(el, _GRADIENTS)
         if chain is None:
             return None
@@ -184,7 +184,7 @@ class Resources:
         units = (self._attr(chain, "gradientUnits") or "objectBoundingBox").strip()
         obb = units != "userSpaceOnUse"
         if obb and (bbox is None or bbox[2] <= 0 or bbox[3] <= 0):
-            return None
+            return "missing"  # no box to map onto: the fallback paint applies (as renderers draw)
         gt = parse_transform(self._attr(chain, "gradientTransform")) or IDENTITY
         m = multiply(multiply(ctm, _box_matrix(bbox)), gt) if obb and bbox else multiply(ctm, gt)
         unit_vp = Viewport(1.0, 1.0, vp.font_size, vp.root_font_size)
@@ -244,7 +244,7 @@ class Resources:
             return out
         return []
 
-    def _pattern(self, el: ET.Element, ctm: Matrix, bbox: Box | None, vp: Viewport) -> Paint:
+    def _pattern(self, el: ET.Element, ctm: Matrix, bbox: Box | None, vp: Viewport) -> Paint | str:
         chain = self._chain(el, ("pattern",))
         if chain is None:
             return None
@@ -252,7 +252,7 @@ class Resources:
         content_units = (self._attr(chain, "patternContentUnits") or "userSpaceOnUse").strip()
         obb = units != "userSpaceOnUse"
         if (obb or content_units == "objectBoundingBox") and (bbox is None or bbox[2] <= 0 or bbox[3] <= 0):
-            return None
+            return "missing"  # no box to map onto: the fallback paint applies (as renderers draw)
         unit_vp = Viewport(1.0, 1.0, vp.font_size, vp.root_font_size)
         tile = []
         for name, axis in (("x", "x"), ("y", "y"), ("width", "x"), ("height", "y")):

@@ -82,3 +82,18 @@ def test_hidden_shapes_count_in_a_group_bounding_box():
     (clip,) = [c for c in defs if "url(#" + c.get("id") + ")" == ref]
     c, _, _ = cubics_from_d(clip[0].get("d"))
     assert (c.real.min(), c.real.max(), c.imag.min(), c.imag.max()) == pytest.approx((0, 50, 0, 100))
+
+
+def test_bounding_box_paint_on_a_shape_without_area_uses_the_fallback():
+    """A vertical line has no box width: an ``objectBoundingBox`` server gives way to the fallback."""
+    servers = (
+        '<linearGradient id="g"><stop offset="0" stop-color="red"/><stop offset="1" stop-color="blue"/>'
+        '</linearGradient><pattern id="p" width="1" height="1"><rect width="5" height="5" fill="red"/></pattern>'
+    )
+    line = '<line x1="50" y1="10" x2="50" y2="90" stroke-width="3" stroke="url(#{}) green"/>'
+    for ref in ("g", "p"):
+        (el,) = parse_svg(svg(servers + line.format(ref))).elements
+        assert style_of(el)["stroke"] == "#008000"
+    # without a fallback its stroke paints nothing
+    (bare,) = parse_svg(svg(servers + line.format("g").replace(" green", ""))).elements
+    assert style_of(bare)["stroke"] == "none"
