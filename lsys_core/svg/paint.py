@@ -13,7 +13,7 @@ import math
 from collections.abc import Callable
 
 from lsys_core.svg.colors import hex_of, parse_color
-from lsys_core.svg.values import Matrix, Viewport, parse_length, to_user
+from lsys_core.svg.values import Matrix, Viewport, parse_length, parse_number, to_user
 
 __all__ = ["Paint", "parse_paint", "scale_of", "stroke_declarations", "unit_value"]
 
@@ -116,14 +116,9 @@ def stroke_declarations(style: dict[str, str], vp: Viewport, scale: float) -> di
     join = style.get("stroke-linejoin", "miter").lower()
     if join != "miter":
         out["stroke-linejoin"] = join
-    limit = style.get("stroke-miterlimit")
-    if limit is not None:
-        try:
-            lim = float(limit)
-        except ValueError:
-            lim = 4.0
-        if lim >= 1.0 and lim != 4.0:
-            out["stroke-miterlimit"] = _num(lim)
+    lim = parse_number(style.get("stroke-miterlimit")) or 4.0  # the cascade dropped values below 1
+    if lim >= 1.0 and lim != 4.0:
+        out["stroke-miterlimit"] = _num(lim)
     dashes = _dashes(style.get("stroke-dasharray"), vp)
     if dashes:
         out["stroke-dasharray"] = ",".join(_num(d * scale) for d in dashes)

@@ -113,7 +113,7 @@ _VALIDATORS = {
     "stroke-width": _length_ok,
     "stroke-dashoffset": _length_ok,
     "stroke-dasharray": _dasharray_ok,
-    "stroke-miterlimit": lambda v: parse_number(v) is not None,
+    "stroke-miterlimit": lambda v: (parse_number(v) or 0.0) >= 1.0,  # below 1 is invalid (SVG 2)
     "clip-path": _url_or_none,
     "mask": _url_or_none,
     "marker-start": _url_or_none,

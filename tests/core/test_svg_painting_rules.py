@@ -97,3 +97,15 @@ def test_bounding_box_paint_on_a_shape_without_area_uses_the_fallback():
     # without a fallback its stroke paints nothing
     (bare,) = parse_svg(svg(servers + line.format("g").replace(" green", ""))).elements
     assert style_of(bare)["stroke"] == "none"
+
+
+def test_invalid_miter_limit_is_ignored_and_the_inherited_one_applies():
+    """``stroke-miterlimit`` below 1 (or not a number) is invalid: the declaration is dropped."""
+    path = '<path d="M0 0 L50 10 L0 20" fill="none" stroke="green" stroke-miterlimit="{}"/>'
+    for bad in ("-10", "0.5", "5mm"):
+        (el,) = parse_svg(svg(f'<g stroke-miterlimit="10">{path.format(bad)}</g>')).elements
+        assert style_of(el)["stroke-miterlimit"] == "10"
+        (el,) = parse_svg(svg(path.format(bad))).elements
+        assert "stroke-miterlimit" not in style_of(el)  # the initial value, 4
+    (el,) = parse_svg(svg(path.format("1.5"))).elements
+    assert style_of(el)["stroke-miterlimit"] == "1.5"
