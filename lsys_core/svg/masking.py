@@ -15,6 +15,7 @@ import numpy as np
 
 from lsys_core.geometry.bezier import transform_cubics
 from lsys_core.geometry.paths import d_from_cubics
+from lsys_core.svg.clipregion import Region, intersect_regions, piece_region, region_d, union_regions
 from lsys_core.svg.paint import split_url
 from lsys_core.svg.resources import Box, Resources, _box_matrix, _esc, _f
 from lsys_core.svg.tree import href_of, local_name, shown
@@ -126,6 +127,9 @@ class Definitions(Resources):
         Intersections are written as clip paths on the pieces, which renderers agree on.
         """
         stored = [(markup, self.intersect(own, outer)) for markup, own in pieces]
+        stored = [(markup, clip) for markup, clip in stored if clip != EMPTY]
+        if not stored:
+            return EMPTY
         new = self.new_id(base)
         self._clip_body[new] = stored
         body = "".join(_with_clip(markup, clip) for markup, clip in stored)
@@ -140,8 +144,38 @@ class Definitions(Resources):
             return EMPTY
         key = ("and", inner, outer)
         if key not in self._cache:
-            self._cache[key] = self._add_clip("clip", self._clip_body[inner], outer)
+            flat = self._flat_intersection(inner, outer)
+            self._cache[key] = flat or self._add_clip("clip", self._clip_body[inner], outer)
         return self._cache[key]  # type: ignore[return-value]
+
+    def _flat_intersection(self, inner: str, outer: str) -> str | None:
+        """The intersection as one outline (see :mod:`.clipregion`); None where it cannot be made."""
+        a, b = self._region(inner), self._region(outer)
+        if a is None or b is None:
+            return None
+        both = intersect_regions(a, b)
+        if both.isEmpty():
+            return EMPTY
+        d, rule = region_d(both, _f)
+        return self._add_clip("clip", [(f'<path d="{d}" clip-rule="{rule}"/>', None)])
+
+    def _region(self, clip: str) -> Region | None:
+        """The region a clip path written here lets through (None: it has text, or no skia)."""
+        key = ("region", clip)
+        if key not in self._cache:
+            regions = []
+            for markup, own in self._clip_body[clip]:
+                r = piece_region(markup)
+                if r is not None and own is not None:
+                    o = self._region(own)
+                    r = None if o is None else intersect_regions(r, o)
+                if r is None:
+                    break
+                regions.append(r)
+            else:
+                self._cache[key] = union_regions(regions)
+            self._cache.setdefault(key, None)
+        return self._cache[key]
 
     def mask(self, value: str | None, ctm: Matrix, bbox: Box | None, vp: Viewport) -> str | None:
         """Rewrite a ``mask`` value for an element: an id, None (no mask) or :data:`EMPTY`."""

@@ -109,3 +109,26 @@ def test_invalid_miter_limit_is_ignored_and_the_inherited_one_applies():
         assert "stroke-miterlimit" not in style_of(el)  # the initial value, 4
     (el,) = parse_svg(svg(path.format("1.5"))).elements
     assert style_of(el)["stroke-miterlimit"] == "1.5"
+
+
+def test_nested_clip_paths_become_one_outline():
+    """A group's clip path and its child's own meet as one outline, not a clip path on a clip path.
+
+    (A clip path on a clip path's children is valid SVG, but librsvg ignores it.)
+    """
+    text = svg(
+        '<clipPath id="a"><rect width="50" height="100"/></clipPath>'
+        '<clipPath id="b"><rect x="25" width="75" height="100"/></clipPath>'
+        '<g clip-path="url(#a)"><rect width="100" height="100" clip-path="url(#b)"/></g>'
+    )
+    scene = parse_svg(text)
+    (el,) = scene.elements
+    defs = ET.fromstring(f'<defs xmlns="http://www.w3.org/2000/svg">{scene.defs}</defs>')
+    (clip,) = [c for c in defs if "url(#" + c.get("id") + ")" == style_of(el)["clip-path"]]
+    (piece,) = list(clip)
+    assert piece.get("clip-path") is None
+    c, _, _ = cubics_from_d(piece.get("d"))
+    assert (c.real.min(), c.real.max(), c.imag.min(), c.imag.max()) == pytest.approx((25, 50, 0, 100))
+    # clip paths that do not meet let nothing through: the element is not drawn
+    apart = text.replace('x="25" width="75"', 'x="60" width="40"')
+    assert style_of(parse_svg(apart).elements[0])["opacity"] == "0"
