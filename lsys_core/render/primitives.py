@@ -42,8 +42,13 @@ def _num(v: float, unit: float = 0.0) -> str:
     return "0" if text == "-0" else text
 
 
-def _straight(cubics: np.ndarray, tol: float) -> np.ndarray:
-    """Whether each segment is a straight line (control points on the chord, between its ends)."""
+def _straight(cubics: np.ndarray, tol: float, max_angle: float = 1e-3) -> np.ndarray:
+    """Whether each segment is a straight line (control points on the chord, between its ends).
+
+    It must also leave and arrive along its chord: a control point a hair off the chord next to
+    an end turns the tangent there (and so a stroke's cap or join) far from the chord's
+    direction, although the curve stays within the tolerance.
+    """
     p0, p1, p2, p3 = (cubics[:, k] for k in range(4))
     chord = p3 - p0
     length = np.abs(chord)
@@ -51,23 +56,11 @@ def _straight(cubics: np.ndarray, tol: float) -> np.ndarray:
     rel = [(p - p0) / safe for p in (p1, p2)]
     off = np.maximum(np.abs(rel[0].imag), np.abs(rel[1].imag)) * length
     inside = np.all([(r.real > -tol) & (r.real < 1 + tol) for r in rel], axis=0)
-    return (length > 0) & (off <= tol) & inside
-
-
-def _ends_along_chord(seg: np.ndarray, max_angle: float = 1e-3) -> bool:
-    """Whether a straight cubic leaves and arrives along its chord (line caps keep their direction).
-
-    A control point a hair off the chord, next to its end point, turns the end's tangent (and so a
-    stroke's cap) far from the chord's direction although the curve stays within the tolerance.
-    """
-    chord = seg[3] - seg[0]
-    for tangent in (
-        next((seg[k] - seg[0] for k in (1, 2, 3) if seg[k] != seg[0]), chord),
-        next((seg[3] - seg[k] for k in (2, 1, 0) if seg[k] != seg[3]), chord),
-    ):
-        if abs(np.angle(tangent / chord)) > max_angle:
-            return False
-    return True
+    # the tangent at each end: towards the first control point that is not on that end
+    start = np.where(p1 != p0, p1 - p0, np.where(p2 != p0, p2 - p0, chord))
+    end = np.where(p2 != p3, p3 - p2, np.where(p1 != p3, p3 - p1, chord))
+    along = (np.abs(np.angle(start / safe)) <= max_angle) & (np.abs(np.angle(end / safe)) <= max_angle)
+    return (length > 0) & (off <= tol) & inside & along
 
 
 def primitive(d: str) -> tuple[str, dict[str, str]] | None:
@@ -104,7 +97,7 @@ def primitive(d: str) -> tuple[str, dict[str, str]] | None:
     tol = TOLERANCE * size
     straight = _straight(cubics, tol)
     if not closed[0]:
-        if cubics.shape[0] == 1 and straight[0] and _ends_along_chord(cubics[0]):
+        if cubics.shape[0] == 1 and straight[0]:
             (p, q) = cubics[0, 0], cubics[0, 3]
             return "line", {"x1": _num(p.real), "y1": _num(p.imag), "x2": _num(q.real), "y2": _num(q.imag)}
         return None

@@ -132,3 +132,12 @@ def test_near_straight_curve_leaving_off_its_chord_is_not_a_line() -> None:
         {"x1": "20", "y1": "160", "x2": "160", "y2": "20"},
     )
     assert primitive("M 0 0 C 0 0 3 3 3 3") is not None  # control points on the ends: along the chord
+
+
+def test_rectangle_side_leaving_its_corner_askew_is_not_a_rect() -> None:
+    """The same for the sides of a rectangle: the join at that corner would change."""
+    assert primitive("M0 0 C0.01 0.005 10 0 10 0 L10 10 L0 10 Z") is None
+    assert primitive("M0 0 C3 0 7 0 10 0 L10 10 L0 10 Z") == (
+        "rect",
+        {"x": "0", "y": "0", "width": "10", "height": "10"},
+    )
