@@ -9,13 +9,13 @@ picture recorded once per fragment (:func:`_picture`, cached), under the view's 
 What a fragment draws here: ``<g>``, ``<a>`` and ``<switch>`` (its first child) groups with
 their transforms (attribute or CSS property) and group ``opacity``; ``<text>`` with
 ``<tspan>``, ``<a>`` and ``<textPath>`` (:mod:`.kept_text`), filled and stroked in solid
-colours in their ``paint-order``; ``<image>`` from a ``data:`` URI (PNG, JPEG, GIF, WebP,
+colours or gradients (:mod:`.paint_servers`, over the whole text's box) in their ``paint-order``; ``<image>`` from a ``data:`` URI (PNG, JPEG, GIF, WebP,
 BMP, ICO) with ``x``/``y``/``width``/``height`` (``auto``: the image's own size) and
 ``preserveAspectRatio``, sampled linearly (nearest for ``image-rendering: pixelated``,
 ``optimizeSpeed`` or ``crisp-edges``).  An image's ``href`` to anything but a ``data:`` URI is
 never fetched, read or drawn, by design (a drawing must not make the renderer open files or
-reach the network).  Not drawn: gradients and patterns on text (their fallback colour if
-given), clip paths, masks and filters on kept content, SVG images, and shapes kept as is.
+reach the network).  Not drawn: patterns on text (their fallback colour if given), clip
+paths, masks and filters on kept content, SVG images, and shapes kept as is.
 
 Why not skia's SVG module (``skia.SVGDOM``) fed the fragment: measured with skia-python
 144.1, it draws neither text (a ``<text>`` of 30-px glyphs: 0 pixels inked, the ``<rect>``
@@ -36,12 +36,14 @@ import urllib.parse
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Iterator
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 
 from lsys_core.derive.model import Drawing
 from lsys_core.render.kept_style import computed, group_opacity, lengths, shape_paints, transform_of
 from lsys_core.render.kept_text import layout_text
+from lsys_core.render.paint_servers import gradient_shader
 from lsys_core.render.sizing import default_view
 from lsys_core.svg.tree import href_of, local_name
 from lsys_core.svg.values import Matrix, viewbox_transform
@@ -173,6 +175,8 @@ class _Painter:
         self.canvas, self.find, self.viewport = canvas, find, viewport
 
     def element(self, el: ET.Element, parent: dict[str, str], depth: int) -> None:
+        import skia
+
         tag = local_name(el.tag)
         if (tag not in _GROUPS and tag not in ("text", "image")) or depth > MAX_DEPTH:
             return
@@ -189,8 +193,17 @@ class _Painter:
         if alpha < 1.0:
             canvas.saveLayerAlpha(None, round(alpha * 255))
         if tag == "text":
-            for run in layout_text(el, style, self.find, self.viewport):
-                for paint in shape_paints(run.style):
+            runs = layout_text(el, style, self.find, self.viewport)
+            box = skia.Rect.MakeEmpty()
+            for run in runs:
+                box.join(run.path.computeTightBounds())
+            bbox = (box.left(), box.top(), box.right(), box.bottom())
+
+            def servers(value: str) -> Any:
+                return gradient_shader(value, self.find, bbox, self.viewport)
+
+            for run in runs:
+                for paint in shape_paints(run.style, True, servers):
                     canvas.drawPath(run.path, paint)
         elif tag == "image":
             self.image(el, style)

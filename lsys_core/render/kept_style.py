@@ -12,8 +12,10 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from typing import Any
 
+from lsys_core.render.paint_servers import NONE
 from lsys_core.render.paths import _number, _Paints, _rgba, _skia_paint, parse_style
 from lsys_core.svg.style import INHERITED, PROPERTIES, font_size_px
 from lsys_core.svg.values import IDENTITY, Matrix, Viewport, parse_length, parse_transform, to_user
@@ -82,31 +84,33 @@ def group_opacity(style: Mapping[str, str]) -> float:
     return max(0.0, min(1.0, _number(style.get("opacity"), 1.0)))
 
 
-def _colour(style: Mapping[str, str], key: str, default: str, opacity_key: str):
+#: A paint server lookup: ``(paint value) -> shader``, :data:`~.paint_servers.NONE` or None.
+Servers = Callable[[str], Any]
+
+
+def _colour(style: Mapping[str, str], key: str, default: str, opacity: float):
     value = style.get(key, default).strip()
-    if value.lower().startswith("url("):
-        # A paint server the own renderer does not draw: its fallback colour, if any.
+    if value.lower().startswith("url("):  # a paint server not drawn here: its fallback colour, if any
         close = value.find(")")
         value = value[close + 1 :].strip() if close >= 0 else ""
         if not value:
             return None
     if value.lower() == "currentcolor":
         value = style.get("color", "black")
-    opacity = max(0.0, min(1.0, _number(style.get(opacity_key), 1.0)))
     rgba = _rgba(value, opacity)
     return rgba if rgba is not None and rgba[3] > 0 else None
 
 
-def shape_paints(style: Mapping[str, str], antialias: bool = True) -> list:
-    """Return the skia paints of a shape with this style, in its paint order (fill, stroke)."""
-    fill = _colour(style, "fill", "black", "fill-opacity")
-    stroke = _colour(style, "stroke", "none", "stroke-opacity")
+def shape_paints(style: Mapping[str, str], antialias: bool = True, servers: Servers | None = None) -> list:
+    """Return the skia paints of a shape with this style, in its paint order (fill, stroke).
+
+    ``servers`` gives the shaders of ``url(#id)`` paints (gradients); without one, or where it
+    has none, the paint's fallback colour is used (none if not given).
+    """
     width = max(0.0, _number(style.get("stroke-width"), 1.0))
-    if width == 0.0 or not math.isfinite(width):
-        stroke = None
-    paints = _Paints(
-        fill=fill,
-        stroke=stroke,
+    stroke_geometry = _Paints(
+        fill=None,
+        stroke=None,
         width=width,
         cap=style.get("stroke-linecap", "butt").lower(),
         join=style.get("stroke-linejoin", "miter").lower(),
@@ -114,10 +118,27 @@ def shape_paints(style: Mapping[str, str], antialias: bool = True) -> list:
         evenodd=False,
     )
     out = []
-    if fill is not None:
-        out.append(_skia_paint(fill, antialias))
-    if stroke is not None:
-        out.append(_skia_paint(stroke, antialias, paints, width))
+    for key, default in (("fill", "black"), ("stroke", "none")):
+        if key == "stroke" and (width == 0.0 or not math.isfinite(width)):
+            continue
+        opacity = max(0.0, min(1.0, _number(style.get(key + "-opacity"), 1.0)))
+        value = style.get(key, default).strip()
+        shader = servers(value) if servers is not None and value.lower().startswith("url(") else None
+        if shader is NONE:
+            continue
+        rgba = (
+            (0, 0, 0, round(opacity * 255)) if shader is not None else _colour(style, key, default, opacity)
+        )
+        if rgba is None or rgba[3] == 0:
+            continue
+        paint = (
+            _skia_paint(rgba, antialias, stroke_geometry, width)
+            if key == "stroke"
+            else _skia_paint(rgba, antialias)
+        )
+        if shader is not None:
+            paint.setShader(shader)
+        out.append(paint)
     order = style.get("paint-order", "normal").split()
     stroke_first = order[:1] == ["stroke"] or order[:2] == ["markers", "stroke"]
     if stroke_first and len(out) == 2:

@@ -11,7 +11,8 @@ The layout follows SVG's text model for horizontal, left-to-right text without l
 * ``dominant-baseline``/``alignment-baseline`` (middle, central, hanging, text-top/bottom and
   the before/after edges) move the baseline by the font's metrics;
 * ``letter-spacing``, ``word-spacing`` and the font's kerning pairs (unless
-  ``font-kerning: none``) adjust the advances;
+  ``font-kerning: none``; as in librsvg, not across the boundary of a ``<tspan>``) adjust
+  the advances;
 * a ``<textPath>``'s characters go along its path (``href`` to a path of the document's
   definitions, or SVG 2's ``path``), from ``startOffset``, each glyph turned to the tangent at
   its middle; glyphs beyond the path's end are not drawn.
@@ -128,6 +129,7 @@ def _face_of(style: Mapping[str, str]) -> _Face:
 class _Char:
     ch: str
     stack: tuple[int, ...]  # indices of the elements the character is in, outermost first
+    span: int  # the piece of character data it comes from (kerning stays within one)
     face: _Face | None = None
     glyph: int = 0
     size: float = 0.0
@@ -153,6 +155,7 @@ class _Collector:
         self.viewport = viewport
         self.elements: list[_Element] = []
         self.chars: list[_Char] = []
+        self.spans = 0
 
     def visit(self, el: ET.Element, style: dict[str, str], stack: tuple[int, ...], preserve: bool) -> None:
         if style.get("display", "").strip().lower() == "none":
@@ -173,6 +176,7 @@ class _Collector:
             self.add(child.tail, stack, pre)
 
     def add(self, text: str | None, stack: tuple[int, ...], pre: bool) -> None:
+        self.spans += 1
         for ch in text or "":
             if ch in "\r\n":
                 if not pre:
@@ -182,7 +186,7 @@ class _Collector:
                 ch = " "
             if ch == " " and not pre and (not self.chars or self.chars[-1].ch == " "):
                 continue
-            self.chars.append(_Char(ch, stack))
+            self.chars.append(_Char(ch, stack, self.spans))
 
     def finish(self) -> list[_Char]:
         while self.chars and self.chars[-1].ch == " " and not self._pre(self.chars[-1]):
@@ -282,7 +286,8 @@ def layout_text(
         if c.ch == " ":
             spacing += _spacing(st, "word-spacing", viewport)
         pen_x += c.advance + spacing
-        if i + 1 < len(chars) and st.get("font-kerning", "auto").strip().lower() != "none":
+        kerning = st.get("font-kerning", "auto").strip().lower() != "none"
+        if kerning and i + 1 < len(chars) and chars[i + 1].span == c.span:  # as librsvg: within a span
             pen_x += c.face.kerning(c.glyph, c.face.glyph(chars[i + 1].ch)) * k
     _anchor(chars, elements)
     runs: list[TextRun] = []

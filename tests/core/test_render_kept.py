@@ -200,3 +200,40 @@ def test_families_resolve_as_fontconfig_does(family):
     assert face.getFamilyName() == expected
     bold, embolden = typeface(family, 700, False)
     assert bold.fontStyle().weight() >= 600 or embolden
+
+
+GRADIENTS = (
+    '<defs><linearGradient id="base"><stop offset="0" stop-color="#ff0000"/>'
+    '<stop offset="1" stop-color="#0000ff"/></linearGradient>'
+    '<linearGradient id="lg" href="#base"/>'
+    '<radialGradient id="rg" gradientUnits="userSpaceOnUse" cx="100" cy="50" r="60">'
+    '<stop offset="0" stop-color="#00ff00"/><stop offset="100%" stop-color="#000000"/></radialGradient>'
+    '<linearGradient id="empty"/><pattern id="pat" width="4" height="4"/></defs>'
+)
+BLOCK = (
+    '<text x="10" y="70" style="font-family:sans-serif;font-size:50px;font-weight:bold;fill:{}">MMMM</text>'
+)
+
+
+def test_gradients_on_text_follow_its_box_and_href_chains():
+    img = render(with_kept(BLOCK.format("url(#lg)"), n=0, defs=GRADIENTS), 200, 100)
+    solid = img[..., 3] == 255
+    cols = np.flatnonzero(solid.any(axis=0))
+    left, right = (
+        img[solid & (np.arange(200) < cols.min() + 6)],
+        img[solid & (np.arange(200) > cols.max() - 6)],
+    )
+    assert left[:, 0].mean() > 200 and left[:, 2].mean() < 60  # red where the box starts
+    assert right[:, 2].mean() > 200 and right[:, 0].mean() < 60  # blue where it ends
+    radial = render(with_kept(BLOCK.format("url(#rg)"), n=0, defs=GRADIENTS), 200, 100)
+    inked = radial[..., 3] == 255
+    near = radial[
+        inked & (np.abs(np.arange(200) - 100) < 8)[None, :] & (np.abs(np.arange(100) - 50) < 8)[:, None]
+    ]
+    far = radial[inked & (np.arange(200) < 25)[None, :]]
+    assert near[:, 1].mean() > 180 and far[:, 1].mean() < near[:, 1].mean() - 60
+    # No stops: nothing drawn.  A pattern (not drawn here): the fallback colour, else nothing.
+    assert not ink(render(with_kept(BLOCK.format("url(#empty)"), n=0, defs=GRADIENTS), 200, 100)).any()
+    assert not ink(render(with_kept(BLOCK.format("url(#pat)"), n=0, defs=GRADIENTS), 200, 100)).any()
+    fallback = render(with_kept(BLOCK.format("url(#pat) #00ff00"), n=0, defs=GRADIENTS), 200, 100)
+    assert (fallback[fallback[..., 3] == 255][:, 1] == 255).all()
