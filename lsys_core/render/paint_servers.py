@@ -92,9 +92,9 @@ def gradient_shader(
 ) -> Any:
     """The shader of the gradient ``value`` (``url(#id)``) for a shape whose box is ``bbox``.
 
-    Returns a skia shader, :data:`NONE` when the gradient paints nothing (no stops, or a box
-    without area for ``objectBoundingBox`` units), or None when ``value`` is not a gradient
-    drawn here (the caller uses the fallback colour).
+    Returns a skia shader, :data:`NONE` when the gradient paints nothing (no stops), or None
+    when ``value`` is not a gradient drawn here or its ``objectBoundingBox`` units meet a box
+    without area (the caller uses the fallback colour).
     """
     import skia
 
@@ -119,8 +119,8 @@ def gradient_shader(
     x0, y0, x1, y1 = bbox
     m = parse_transform(attrs.get("gradientTransform")) or IDENTITY
     if bounding:
-        if x1 - x0 <= 0 or y1 - y0 <= 0:
-            return NONE
+        if x1 - x0 <= 0 or y1 - y0 <= 0:  # as renderers do: the fallback colour, if any
+            return None
         m = multiply((x1 - x0, 0.0, 0.0, y1 - y0, x0, y0), m)
     vp = Viewport(1.0, 1.0, 16.0, 16.0) if bounding else Viewport(viewport[0], viewport[1])
 
