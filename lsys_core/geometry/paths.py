@@ -44,6 +44,8 @@ MAX_COORD = 1e12
 
 #: Default significant digits of numbers written into path data (relative error <= 5e-9).
 DEFAULT_PRECISION = 9
+#: Segments written at once by :func:`d_from_cubics`.
+_WRITE_BLOCK = 1 << 15
 
 
 def _empty() -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
@@ -306,12 +308,17 @@ def d_from_cubics(
 
     num = f"%.{int(precision)}g"
     pair = f"{num} {num}"
-    pieces = np.where(is_line, f"L{pair} ", f"C{pair} {pair} {pair} ")
-    pieces[as_z] = ""
-    text = np.char.add(np.char.add(np.where(first, f"M{pair} ", ""), pieces), np.where(seg_closed, "Z ", ""))
-    template = "".join(text.tolist())
     # Per segment, the numbers its commands write: start (M), controls (C), end (L, C).
     use_c = ~is_line & ~as_z
     mask = np.stack([first, use_c, use_c, ~as_z], axis=1)  # (k, 4) over p0, c1, c2, p3
-    values = xy[mask]  # row-major: segment by segment, points in order
-    return (template % tuple(values.ravel().tolist())).rstrip()
+    out = []
+    for lo in range(0, k, _WRITE_BLOCK):  # blocks: fixed-width string arrays of 10^6 segments take GiBs
+        part = slice(lo, lo + _WRITE_BLOCK)
+        pieces = np.where(is_line[part], f"L{pair} ", f"C{pair} {pair} {pair} ")
+        pieces[as_z[part]] = ""
+        text = np.char.add(
+            np.char.add(np.where(first[part], f"M{pair} ", ""), pieces), np.where(seg_closed[part], "Z ", "")
+        )
+        values = xy[part][mask[part]]  # row-major: segment by segment, points in order
+        out.append("".join(text.tolist()) % tuple(values.ravel().tolist()))
+    return "".join(out).rstrip()

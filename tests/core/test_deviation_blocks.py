@@ -1,0 +1,68 @@
+"""Memory-bounded steps give the same answers as the one-pass ones they replace.
+
+A copy drawn with the same segments as its shape is measured by its control points (no
+polylines); path data is written, and shapes are placed, in blocks of segments.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lsys_core.geometry import paths
+from lsys_core.instancing import deviation
+from lsys_core.svg import parse
+from lsys_core.svg.model import Element
+from lsys_core.svg.parse import parse_svg
+
+_ZIGZAG = "M0 0 " + " ".join(f"L{i} {(i % 2) * 7}" for i in range(1, 400)) + " C 410 20 420 -20 430 0 Z"
+
+
+def _element(d: str) -> Element:
+    svg = f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 500 500"><path d="{d}"/></svg>'
+    return parse_svg(svg.encode()).elements[0]
+
+
+def test_a_copy_with_the_same_segments_is_measured_without_polylines(monkeypatch):
+    el = _element(_ZIGZAG)
+    shape = Element(el.cubics - 5, el.subpaths, el.closed)
+    monkeypatch.setattr(deviation, "_polyline", lambda *a, **k: pytest.fail("sampled a copy"))
+    got = deviation.pose_deviations([el], [shape], np.array([0]), np.array([1 + 0j]), np.array([5 + 0j]))
+    assert got[0] <= 1e-9
+
+
+def test_the_same_segments_at_a_wrong_scale_are_still_measured():
+    el = _element("M0 0 L100 0 L100 100 L0 100 Z")
+    shape = Element(el.cubics * 0.8, el.subpaths, el.closed)
+    got = deviation.pose_deviations([el], [shape], np.array([0]), np.array([1 + 0j]), np.array([0j]))
+    assert got[0] == pytest.approx(20 * 2**0.5, rel=1e-6)  # the far corner, (100, 100) from (80, 80)
+
+
+def test_a_square_traced_from_another_corner_is_an_exact_copy():
+    el = _element("M0 0 L100 0 L100 100 L0 100 Z")
+    other = _element("M100 100 L0 100 L0 0 L100 0 Z")  # same segments count, other order
+    got = deviation.pose_deviations([other], [el], np.array([0]), np.array([1 + 0j]), np.array([0j]))
+    assert got[0] <= 1e-6
+
+
+def test_path_data_written_in_blocks_is_the_same(monkeypatch):
+    el = _element(_ZIGZAG + " M 5 5 L 9 9 C 10 10 11 12 13 14 L 5 5 Z")
+    whole = paths.d_from_cubics(el.cubics, el.subpaths, el.closed)
+    monkeypatch.setattr(paths, "_WRITE_BLOCK", 3)
+    assert paths.d_from_cubics(el.cubics, el.subpaths, el.closed) == whole
+
+
+def test_shapes_placed_in_blocks_are_the_same(monkeypatch):
+    svg = (
+        '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 500 500">'
+        f'<path d="{_ZIGZAG}" transform="rotate(30) scale(2 1)"/>'
+        '<g transform="translate(10 20)"><rect width="5" height="5"/><circle r="3" cx="40"/></g>'
+        '<path d="M0 0 L0 0"/><path d="M0 0 L1e300 0"/></svg>'
+    ).encode()
+    whole = parse_svg(svg)
+    monkeypatch.setattr(parse, "_BLOCK", 5)
+    blocks = parse_svg(svg)
+    assert len(blocks.elements) == len(whole.elements) == 3
+    assert blocks.warnings == whole.warnings
+    for a, b in zip(blocks.elements, whole.elements, strict=True):
+        np.testing.assert_array_equal(a.cubics, b.cubics)
