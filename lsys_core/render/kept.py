@@ -44,6 +44,7 @@ from lsys_core.derive.model import Drawing
 from lsys_core.render.kept_style import computed, group_opacity, lengths, shape_paints, transform_of
 from lsys_core.render.kept_text import layout_text
 from lsys_core.render.paint_servers import gradient_shader
+from lsys_core.render.served import draw_served, served_instances
 from lsys_core.render.sizing import default_view
 from lsys_core.svg.tree import href_of, local_name
 from lsys_core.svg.values import Matrix, viewbox_transform
@@ -63,22 +64,34 @@ _BIG = 1e9
 
 
 class Kept:
-    """A drawing's kept content: where it goes among the instances, and drawing it.
+    """A drawing's kept content, and its instances painted by gradients: where they go among the
+    other instances, and drawing them.
 
-    Items with the same ``order`` keep their document order.
+    Kept items go after the ``order`` first instances (those with the same ``order`` in
+    document order); an instance painted by a gradient (:mod:`.served`) goes at its own place,
+    after the kept items placed before it.  Without ``terminal`` (the renderer's cache of
+    terminal paths), there are no such instances: all are drawn by the renderer's passes.
     """
 
-    def __init__(self, drawing: Drawing) -> None:
+    def __init__(self, drawing: Drawing, terminal: Callable[[str, str], Any] | None = None) -> None:
         n = len(drawing)
-        items = sorted(((min(max(int(v.order), 0), n), v.xml) for v in drawing.verbatim), key=lambda t: t[0])
-        self.orders = np.array([o for o, _ in items], dtype=np.intp)
-        self.xml = [x for _, x in items]
-        self.defs = drawing.defs
+        kept = np.array([min(max(int(v.order), 0), n) for v in drawing.verbatim], dtype=np.intp)
+        served = served_instances(drawing) if terminal is not None else np.zeros(0, np.intp)
+        orders = np.concatenate([kept, served])
+        kind = np.r_[np.zeros(kept.size, np.intp), np.ones(served.size, np.intp)]
+        perm = np.lexsort((np.arange(orders.size), kind, orders))
+        self.orders = orders[perm]
+        #: What each item is: verbatim markup, or the index of an instance painted by a gradient.
+        self.refs: list[str | int] = [
+            drawing.verbatim[k].xml if k < kept.size else int(served[k - kept.size]) for k in perm.tolist()
+        ]
+        self.served = served
+        self.drawing, self.terminal, self.defs = drawing, terminal, drawing.defs
         _, _, w, h = default_view(drawing)
         self.viewport = (float(w), float(h))  # what percentages refer to
 
     def __bool__(self) -> bool:
-        return bool(self.xml)
+        return bool(self.refs)
 
     def steps(
         self, idx: np.ndarray, runs: list[tuple[int, int]]
@@ -109,12 +122,18 @@ class Kept:
                 yield "kept", p, p, cuts[p]
 
     def draw(self, canvas, items: list[int] | None, view: tuple[float, float, float]) -> None:
-        """Draw the kept ``items`` (all: None) under the view ``(scale, tx, ty)``."""
+        """Draw the ``items`` (all: None) under the view ``(scale, tx, ty)``."""
         import skia
 
         s, tx, ty = view
-        for k in range(len(self.xml)) if items is None else items:
-            picture = _picture(self.xml[k], self.defs, self.viewport)
+        for k in range(len(self.refs)) if items is None else items:
+            ref = self.refs[k]
+            if isinstance(ref, int):
+                if self.terminal is not None:
+                    find = _index(self.defs).get
+                    draw_served(canvas, self.drawing, ref, self.terminal, find, self.viewport, view)
+                continue
+            picture = _picture(ref, self.defs, self.viewport)
             if picture is None:
                 continue
             canvas.save()
@@ -133,6 +152,17 @@ def _parse(markup: str) -> ET.Element | None:
         return None
 
 
+@lru_cache(maxsize=4)
+def _index(defs: str) -> dict[str, ET.Element]:
+    """The elements of a drawing's definitions by id."""
+    root = _parse(defs)
+    out: dict[str, ET.Element] = {}
+    for el in root.iter() if root is not None else ():
+        if el.get("id"):
+            out.setdefault(el.get("id", ""), el)
+    return out
+
+
 @lru_cache(maxsize=PICTURE_CACHE)
 def _picture(markup: str, defs: str, viewport: tuple[float, float]):
     """Record what a kept fragment draws, in document coordinates (None: nothing to draw)."""
@@ -141,15 +171,17 @@ def _picture(markup: str, defs: str, viewport: tuple[float, float]):
     root = _parse(markup)
     if root is None:
         return None
-    index: dict[str, ET.Element] = {}
+    local: dict[str, ET.Element] = {}
 
     def find(ident: str) -> ET.Element | None:
-        if "" not in index:  # built on first use: the fragment's ids, then the definitions'
-            for tree in (root, _parse(defs)):
-                for el in tree.iter() if tree is not None else ():
-                    index.setdefault(el.get("id") or "", el)
-            index.setdefault("", root)
-        return index.get(ident) if ident else None
+        if "" not in local:  # built on first use: the fragment's ids, then the definitions'
+            for node in root.iter():
+                local.setdefault(node.get("id") or "", node)
+            local[""] = root
+        if not ident:
+            return None
+        found = local.get(ident)
+        return found if found is not None else _index(defs).get(ident)
 
     recorder = skia.PictureRecorder()
     canvas = recorder.beginRecording(skia.Rect.MakeLTRB(-_BIG, -_BIG, _BIG, _BIG))

@@ -23,6 +23,10 @@ within :data:`DRAFT_TOLERANCE` pixels and with thin strokes as hairlines: much
 faster, but overlaps between different terminals or scale groups no longer follow
 the instance order (within a group, chunks are drawn in instance order).
 
+Content kept as is (text, images) and instances painted by gradients are drawn at their
+places in the paint order in full mode (:mod:`lsys_core.render.kept`, :mod:`.served`); in
+draft mode, what comes before every instance is drawn under them and the rest on top.
+
 skia is imported inside the functions that use it.
 """
 
@@ -186,7 +190,7 @@ class Renderer:
         canvas.resetMatrix()
         canvas.clear(skia.ColorSetARGB(a, r, g, b))
         n = len(drawing)
-        kept = Kept(drawing)
+        kept = Kept(drawing, self._terminal)
         if n == 0 and not kept:
             return self._pixels
         s, tx, ty = fit_view(view if view is not None else default_view(drawing), width, height)
@@ -202,6 +206,7 @@ class Renderer:
             da = s * pa
             db = s * pb + complex(tx, ty)
         visible = self._visible(terms, symbol, da, db, sscale, width, height)
+        visible[kept.served] = False  # gradient-painted: drawn by kept, at their places
         if draft:  # kept content placed before every instance goes under them, the rest on top
             kept.draw(canvas, np.flatnonzero(kept.orders == 0).tolist(), (s, tx, ty))
             self._draw_batched(terms, symbol, da, db, sscale, visible)

@@ -12,9 +12,9 @@ checkout): infer, derive, then render
 all at the same size (longest side ``--side`` pixels), and print per file the share of inked
 pixels (alpha >= 128 in either image) whose colour or coverage differs from the input's rendering
 (any channel by more than 32 of 255).  Target: <= 2 % for both.  The project's own renderer
-draws content kept as is (text laid out with fontconfig's faces, ``data:`` images) at its place
-in the paint order (``lsys_core.render.kept``); what it does not draw there (gradients on text,
-clip paths and masks of kept content) shows up as a difference.  Needs rsvg-convert (Debian:
+draws content kept as is (text laid out with fontconfig's faces, ``data:`` images) and
+gradient paints at their places in the paint order (``lsys_core.render.kept``); what it does
+not draw (patterns, clip paths, masks, filters, dashes) shows up as a difference.  Needs rsvg-convert (Debian:
 librsvg2-bin).
 """
 

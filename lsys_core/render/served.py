@@ -1,0 +1,95 @@
+"""Instances painted by gradients (``fill``/``stroke`` ``url(#id)``), drawn one by one by the own renderer.
+
+A paint server's coordinates are the canvas's (``userSpaceOnUse``) or the painted shape's box
+there (``objectBoundingBox``), as the SVG export writes such instances baked into canvas
+coordinates.  So each one is drawn as its outline mapped by its pose into the canvas, with
+the gradient's shader (:mod:`.paint_servers`) over that outline's box, its stroke width in
+canvas units (times the scale for a ``scaled`` terminal) and its ``opacity`` as a group.
+The fast passes of :mod:`.raster` leave these instances out; :class:`~.kept.Kept` places
+them in the paint order.  Patterns and servers that cannot be found use the fallback colour.
+skia is imported inside the functions.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from lsys_core.derive.model import Drawing
+from lsys_core.render.kept_style import group_opacity, shape_paints
+from lsys_core.render.paint_servers import gradient_shader
+from lsys_core.render.paths import _number, parse_style
+
+__all__ = ["draw_served", "served_instances"]
+
+
+def _served_style(style: str) -> bool:
+    decls = parse_style(style)
+    return any("url(" in decls.get(k, "").lower() for k in ("fill", "stroke"))
+
+
+def served_instances(drawing: Drawing) -> np.ndarray:
+    """Return the indices of the instances whose fill or stroke is a ``url(#id)`` paint."""
+    n = len(drawing)
+    if n == 0:
+        return np.zeros(0, np.intp)
+    styles, style = drawing.instance_styles()
+    served = np.array([_served_style(s) for s in styles] + [False])
+    if not served.any():
+        return np.zeros(0, np.intp)
+    index = np.asarray(style, np.intp).reshape(n)
+    index = np.where((index >= 0) & (index < len(styles)), index, len(styles))
+    return np.flatnonzero(served[index])
+
+
+def draw_served(
+    canvas,
+    drawing: Drawing,
+    i: int,
+    terminal: Callable[[str, str], Any],
+    find: Callable[[str], ET.Element | None],
+    viewport: tuple[float, float],
+    view: tuple[float, float, float],
+) -> None:
+    """Draw instance ``i`` of ``drawing`` with its paint servers, under the view ``(scale, tx, ty)``.
+
+    ``terminal(path, style)`` gives the renderer's cached skia objects of a terminal.
+    """
+    import skia
+
+    sym = int(drawing.symbol[i])
+    styles, style = drawing.instance_styles()
+    if not (0 <= sym < len(drawing.terminals)) or not (0 <= int(style[i]) < len(styles)):
+        return
+    a, b = complex(drawing.a[i]), complex(drawing.b[i])
+    if not (np.isfinite(a) and np.isfinite(b)):
+        return
+    term, css = drawing.terminals[sym], styles[int(style[i])]
+    path = skia.Path(terminal(term.path, css).path)
+    path.transform(skia.Matrix.MakeAll(a.real, -a.imag, b.real, a.imag, a.real, b.imag, 0, 0, 1))
+    box = path.computeTightBounds()
+    bbox = (box.left(), box.top(), box.right(), box.bottom())
+    decls = parse_style(css)
+    if term.scaled:  # its stroke scales with the instance
+        decls["stroke-width"] = repr(_number(decls.get("stroke-width"), 1.0) * abs(a))
+
+    def servers(value: str) -> Any:
+        return gradient_shader(value, find, bbox, viewport)
+
+    paints = shape_paints(decls, True, servers)
+    alpha = group_opacity(decls)
+    if not paints or alpha <= 0.0:
+        return
+    s, tx, ty = view
+    canvas.save()
+    canvas.setMatrix(skia.Matrix.MakeAll(s, 0, tx, 0, s, ty, 0, 0, 1))
+    if alpha < 1.0:
+        canvas.saveLayerAlpha(None, round(alpha * 255))
+    for paint in paints:
+        canvas.drawPath(path, paint)
+    if alpha < 1.0:
+        canvas.restore()
+    canvas.restore()

@@ -1,0 +1,52 @@
+"""The own renderer paints instances whose fill or stroke is a gradient, at their place in the paint order."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from lsys_core.grammar.model import Terminal
+from lsys_core.render.raster import render
+
+from .scenes import make_drawing
+
+SQUARE = "M0 0 L10 0 L10 10 L0 10 Z"
+DEFS = (
+    '<defs><linearGradient id="box"><stop offset="0" stop-color="#ff0000"/>'
+    '<stop offset="1" stop-color="#0000ff"/></linearGradient>'
+    '<linearGradient id="canvas" gradientUnits="userSpaceOnUse" x1="0" y1="0" x2="200" y2="0">'
+    '<stop offset="0" stop-color="#ff0000"/><stop offset="1" stop-color="#0000ff"/></linearGradient></defs>'
+)
+
+
+def drawing(style: str, cover: bool = False):
+    terminals = [Terminal("S", SQUARE, style), Terminal("K", SQUARE, "fill:#000000")]
+    symbol, a, b = [0, 0], [2, 4], [10 + 10j, 100 + 20j]
+    if cover:  # a black square drawn after the second one, over its left half
+        symbol, a, b = [*symbol, 1], [*a, 2], [*b, 100 + 30j]
+    return replace(make_drawing(terminals, symbol, a, b, (0.0, 0.0, 200.0, 100.0)), defs=DEFS)
+
+
+def test_object_box_gradients_follow_each_instance():
+    img = render(drawing("fill:url(#box)"), 200, 100)
+    for x0, x1, y in ((10, 30, 20), (100, 140, 40)):
+        left, right = img[y, x0 + 1], img[y, x1 - 2]
+        assert left[0] > 200 and left[2] < 60, left  # red at the left of its own box
+        assert right[2] > 200 and right[0] < 60, right  # blue at the right
+    # Drawn without the gradient (as before), both would be one flat colour.
+    assert abs(int(img[20, 11, 0]) - int(img[20, 28, 0])) > 150
+
+
+def test_canvas_gradients_depend_on_the_canvas_position_and_keep_paint_order():
+    img = render(drawing("fill:url(#canvas)", cover=True), 200, 100)
+    # x = 20 is a tenth of the way: mostly red; x = 130 about two thirds: more blue than red.
+    assert img[20, 20, 0] > 200 and img[20, 20, 2] < 40
+    assert img[50, 130, 2] > img[50, 130, 0]
+    # The black square drawn after covers the gradient-painted one.
+    assert (img[35:45, 102:118, :3] == 0).all()
+
+
+def test_stroke_gradients_and_opacity():
+    img = render(drawing("fill:none;stroke:url(#box);stroke-width:4;opacity:0.5"), 200, 100)
+    assert img[40, 100, 3] in range(120, 136)  # half-transparent stroke on the left side
+    assert img[40, 100, 0] > 200 and img[40, 139, 2] > 200  # red left, blue right
+    assert img[40, 120, 3] == 0  # no fill
