@@ -3,8 +3,10 @@
 As for paint servers (:mod:`.resources`), a clip path or mask is rewritten for each element that
 uses it: the element's transform and, for ``objectBoundingBox`` units, its box are folded into the
 clip path's geometry or the mask's content transform, and units become ``userSpaceOnUse``.
-Nested clips (a clip path on a clip path or on one of its children) are written as clip paths on
-the pieces, which renderers agree on.
+Clips that meet (a group's and its child's, a viewport's and a shape's) are intersected into one
+outline (:mod:`.clipregion`), which every renderer draws.  A clip path on a clip path or on one of
+its children, and intersections involving text, are written as clip paths on the pieces (valid
+SVG, which librsvg 2.54 ignores, as it does in the input).
 """
 
 from __future__ import annotations
@@ -22,10 +24,12 @@ from lsys_core.svg.tree import href_of, local_name, shown
 from lsys_core.svg.values import IDENTITY, Matrix, Viewport, multiply, parse_length, parse_transform, to_user
 from lsys_core.svg.verbatim import matrix_text, style_text, subtree_markup
 
-__all__ = ["EMPTY", "Definitions"]
+__all__ = ["EMPTY", "MAX_REGION_PIECES", "Definitions"]
 
 #: Returned by :meth:`Definitions.clip` for a clip path that lets nothing through.
 EMPTY = "empty"
+#: Clip paths of more pieces than this are intersected piece-wise (unions of many outlines are slow).
+MAX_REGION_PIECES = 64
 _CLIP_SHAPES = frozenset({"path", "rect", "circle", "ellipse", "line", "polyline", "polygon"})
 
 
@@ -162,9 +166,12 @@ class Definitions(Resources):
     def _region(self, clip: str) -> Region | None:
         """The region a clip path written here lets through (None: it has text, or no skia)."""
         key = ("region", clip)
+        body = self._clip_body[clip]
+        if len(body) > MAX_REGION_PIECES:
+            return None
         if key not in self._cache:
             regions = []
-            for markup, own in self._clip_body[clip]:
+            for markup, own in body:
                 r = piece_region(markup)
                 if r is not None and own is not None:
                     o = self._region(own)
