@@ -4,7 +4,9 @@ A terminal keeps its shape as SVG path data (what the ``.lsys`` file says is wha
 many stages need its arrays: fidelity and shape similarity, pivots, validation, SVG export and
 raster rendering.  :func:`shape_arrays` parses each distinct path text once and hands every later
 caller the same read-only arrays.  The cache is bounded by the number of segments it holds, so a
-session that edits many shapes does not grow without limit.
+session that edits many shapes does not grow without limit; a shape larger than that bound is
+kept alone in a slot of its own (the last one asked for), since a scene of one huge path asks
+for it from several stages (seven parses of a 10^6-line path took 14 s of a 35 s inference).
 """
 
 from __future__ import annotations
@@ -18,13 +20,14 @@ from lsys_core.geometry.paths import cubics_from_d
 
 __all__ = ["CACHE_SEGMENTS", "shape_arrays"]
 
-#: Segments kept in the cache at most (about 72 bytes each); a larger shape is parsed, not kept.
+#: Segments kept in the cache at most (about 72 bytes each); a larger shape has a slot of its own.
 CACHE_SEGMENTS = 250_000
 
 _Arrays = tuple[np.ndarray, np.ndarray, tuple[bool, ...]]
 
 _cache: OrderedDict[str, _Arrays] = OrderedDict()
 _held = 0  # segments in the cache
+_large: tuple[str, _Arrays] | None = None  # the last shape too large for the cache
 _lock = threading.Lock()  # the editor renders while a worker thread infers
 
 
@@ -49,12 +52,14 @@ def shape_arrays(d: str) -> _Arrays:
     SvgError
         If the path data cannot be parsed (not cached: every call raises again).
     """
-    global _held
+    global _held, _large
     with _lock:
         hit = _cache.get(d)
         if hit is not None:
             _cache.move_to_end(d)
             return hit
+        if _large is not None and _large[0] == d:
+            return _large[1]
     if d.strip():
         cubics, subpaths, closed = cubics_from_d(d)
     else:
@@ -64,6 +69,8 @@ def shape_arrays(d: str) -> _Arrays:
     arrays = (cubics, subpaths, closed)
     k = len(cubics)
     if k > CACHE_SEGMENTS:
+        with _lock:
+            _large = (d, arrays)
         return arrays
     with _lock:
         if d not in _cache:

@@ -34,7 +34,6 @@ Numbers are formatted by one ``%`` operation over all instances, as in the flat 
 
 from __future__ import annotations
 
-import math
 import re
 from xml.sax.saxutils import escape
 
@@ -42,8 +41,7 @@ import numpy as np
 
 from lsys_core.derive.model import Calls, Drawing
 from lsys_core.derive.paint import css_decls, css_text
-from lsys_core.errors import LsysError
-from lsys_core.geometry.shapes import shape_arrays
+from lsys_core.render.compact import compact_path_data as _compact
 from lsys_core.render.primitives import primitive
 from lsys_core.render.svg import DIGITS, _attr, _baked_path, _canvas, _length, check_finite
 
@@ -55,12 +53,8 @@ _LENGTH_KEYS = ("stroke-width", "stroke-dasharray", "stroke-dashoffset")
 _PATH_ONLY = ("stroke-dasharray", "marker", "marker-start", "marker-mid", "marker-end")
 _ID = re.compile(r"""\bid\s*=\s*["']([^"']*)["']""")
 _XLINK = "http://www.w3.org/1999/xlink"
-_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
 #: Deepest nesting of groups written (SVG readers, this project's included, limit nesting).
 MAX_DEPTH = 100
-#: Precision of the numbers in a terminal's path data, relative to the shape's size (a shape
-#: 1,000 px wide is written to a thousandth of a pixel).
-PATH_PRECISION = 1e-6
 
 
 def drawing_to_structured_svg(drawing: Drawing, *, head=None) -> str:
@@ -252,33 +246,6 @@ def _definition(path: str, ref: str, common: dict[str, str], path_only: bool) ->
         f'{k}="{_attr(v)}"' for k, v in attrs.items() if not (k in ("x", "y", "cx", "cy") and v == "0")
     )
     return f'<{tag} id="{_attr(ref)}" {text}{style}/>\n'
-
-
-def _compact(d: str) -> str:
-    """Return path data with its numbers rounded to :data:`PATH_PRECISION` of the shape's size.
-
-    Path data with arcs is left as it is (their flags may be written without separators).
-    """
-    if "a" in d.lower():
-        return d
-    try:
-        cubics = shape_arrays(d)[0]
-    except LsysError:
-        return d
-    if cubics.size == 0 or not np.isfinite(cubics).all():
-        return d
-    size = float(max(np.ptp(cubics.real), np.ptp(cubics.imag), np.abs(cubics).max()))
-    if size <= 0:
-        return d
-    decimals = max(0, -math.floor(math.log10(size * PATH_PRECISION)))
-
-    def fix(mt: re.Match) -> str:
-        text = f"{round(float(mt.group()), decimals):.{decimals}f}"
-        if "." in text:
-            text = text.rstrip("0").rstrip(".")
-        return "0" if text in ("-0", "") else text
-
-    return _NUMBER.sub(fix, d)
 
 
 def _values(a, b, scale, uses: _Uses, drawing) -> tuple[np.ndarray, np.ndarray, list[str]]:

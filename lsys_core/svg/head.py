@@ -11,7 +11,6 @@ travel with the scene itself.
 
 from __future__ import annotations
 
-import io
 import re
 from dataclasses import dataclass
 
@@ -47,7 +46,7 @@ def read_head(data: bytes) -> Head:
     """
     import defusedxml.ElementTree as DET
 
-    from lsys_core.svg.xmlsafe import DEFAULT_MAX_BYTES, maybe_gunzip
+    from lsys_core.svg.xmlsafe import DEFAULT_MAX_BYTES, ChunkReader, maybe_gunzip
 
     prefixes: dict[str, str] = {}
     attrs: list[tuple[str, str]] = []
@@ -55,7 +54,7 @@ def read_head(data: bytes) -> Head:
     depth = 0
     try:
         data = maybe_gunzip(data, DEFAULT_MAX_BYTES, "")
-        events = DET.iterparse(io.BytesIO(data), events=("start-ns", "start", "end"), forbid_dtd=False)
+        events = DET.iterparse(ChunkReader(data), events=("start-ns", "start", "end"), forbid_dtd=False)
         for event, item in events:
             if event == "start-ns":
                 prefix, uri = item

@@ -46,3 +46,20 @@ def test_cache_holds_a_bounded_number_of_segments(monkeypatch: pytest.MonkeyPatc
     assert sum(len(v[0]) for v in shapes._cache.values()) == shapes._held
     big = "M0 0 " + " ".join(f"L{i} {i % 2}" for i in range(1, 30))
     assert len(shape_arrays(big)[0]) > 10 and big not in shapes._cache
+
+
+def test_the_last_large_shape_is_parsed_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(shapes, "CACHE_SEGMENTS", 10)
+    monkeypatch.setattr(shapes, "_cache", type(shapes._cache)())
+    monkeypatch.setattr(shapes, "_held", 0)
+    monkeypatch.setattr(shapes, "_large", None)
+    parsed: list[str] = []
+    real = shapes.cubics_from_d
+    monkeypatch.setattr(shapes, "cubics_from_d", lambda d: parsed.append(d) or real(d))
+    big = "M0 0 " + " ".join(f"L{i} {i % 2}" for i in range(1, 30))
+    other = "M0 0 " + " ".join(f"L{i} {i % 3}" for i in range(1, 30))
+    first = shape_arrays(big)
+    assert shape_arrays(big) is first and parsed == [big]
+    shape_arrays(other)  # takes the slot: one large shape is held, not every one
+    assert shape_arrays(big) is not first and parsed == [big, other, big]
+    assert shapes._held == 0

@@ -1,7 +1,7 @@
 """Memory-bounded steps give the same answers as the one-pass ones they replace.
 
 A copy drawn with the same segments as its shape is measured by its control points (no
-polylines); path data is written, and shapes are placed, in blocks of segments.
+polylines); path data is written, rounded, and shapes are placed, in blocks of segments.
 """
 
 from __future__ import annotations
@@ -11,6 +11,7 @@ import pytest
 
 from lsys_core.geometry import paths
 from lsys_core.instancing import deviation
+from lsys_core.render import compact
 from lsys_core.svg import parse
 from lsys_core.svg.model import Element
 from lsys_core.svg.parse import parse_svg
@@ -66,3 +67,12 @@ def test_shapes_placed_in_blocks_are_the_same(monkeypatch):
     assert blocks.warnings == whole.warnings
     for a, b in zip(blocks.elements, whole.elements, strict=True):
         np.testing.assert_array_equal(a.cubics, b.cubics)
+
+
+def test_path_data_rounded_in_pieces_is_the_same():
+    d = _ZIGZAG.replace(" L", " l0.12345 -0.5e-3 L") + " m 1.25,2.5e1 h -3.000001 v.5 Z"
+    pieces = list(compact._pieces(d, 40))
+    assert len(pieces) > 10 and "".join(pieces) == d
+    assert all(p[0].isalpha() for p in pieces)  # cut before command letters, never in a number
+    assert "".join(compact._rounded(p, 2) for p in pieces) == compact._rounded(d, 2)
+    assert compact._rounded("M-0.001 10.000 L 2.50 -3e-5 100 0.105", 2) == "M0 10 L 2.5 0 100 0.1"
