@@ -14,8 +14,9 @@ BMP, ICO) with ``x``/``y``/``width``/``height`` (``auto``: the image's own size)
 ``preserveAspectRatio``, sampled linearly (nearest for ``image-rendering: pixelated``,
 ``optimizeSpeed`` or ``crisp-edges``).  An image's ``href`` to anything but a ``data:`` URI is
 never fetched, read or drawn, by design (a drawing must not make the renderer open files or
-reach the network).  Not drawn: patterns on text (their fallback colour if given), clip
-paths, masks and filters on kept content, SVG images, and shapes kept as is.
+reach the network).  Clip paths apply (:mod:`.clipping`; ``objectBoundingBox`` units on text
+and sized images only).  Not drawn: patterns on text (their fallback colour if given), masks
+and filters on kept content, SVG images, and shapes kept as is.
 
 Why not skia's SVG module (``skia.SVGDOM``) fed the fragment: measured with skia-python
 144.1, it draws neither text (a ``<text>`` of 30-px glyphs: 0 pixels inked, the ``<rect>``
@@ -41,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from lsys_core.derive.model import Drawing
+from lsys_core.render.clipping import clip_region
 from lsys_core.render.kept_style import computed, group_opacity, lengths, shape_paints, transform_of
 from lsys_core.render.kept_text import layout_text
 from lsys_core.render.paint_servers import gradient_shader
@@ -222,14 +224,17 @@ class _Painter:
         canvas = self.canvas
         canvas.save()
         canvas.concat(_skia_matrix(m))
+        runs, box = layout_text(el, style, self.find, self.viewport) if tag == "text" else ([], None)
+        bbox = box or (0.0, 0.0, 0.0, 0.0)
+        clip = style.get("clip-path", "")
+        if "url(" in clip:
+            known = bbox if tag == "text" else self._image_box(el, style) if tag == "image" else None
+            region = clip_region(clip, self.find, known, self.viewport)
+            if region is not None:
+                canvas.clipPath(region, skia.ClipOp.kIntersect, True)
         if alpha < 1.0:
             canvas.saveLayerAlpha(None, round(alpha * 255))
         if tag == "text":
-            runs = layout_text(el, style, self.find, self.viewport)
-            box = skia.Rect.MakeEmpty()
-            for run in runs:
-                box.join(run.path.computeTightBounds())
-            bbox = (box.left(), box.top(), box.right(), box.bottom())
 
             def servers(value: str) -> Any:
                 return gradient_shader(value, self.find, bbox, self.viewport)
@@ -251,6 +256,13 @@ class _Painter:
         """One length attribute in user units (None: missing, ``auto`` or unreadable)."""
         values = lengths(el.get(key), style, self.viewport, "y" if key in ("y", "height") else "x")
         return values[0] if values else None
+
+    def _image_box(self, el: ET.Element, style: dict[str, str]) -> tuple[float, float, float, float] | None:
+        """An image's box when its width and height are given (None: they depend on the image)."""
+        x, y, w, h = (self._length(el, k, style) for k in ("x", "y", "width", "height"))
+        if w is None or h is None:
+            return None
+        return (x or 0.0, y or 0.0, (x or 0.0) + w, (y or 0.0) + h)
 
     def image(self, el: ET.Element, style: dict[str, str]) -> None:
         """Draw an ``<image>`` whose ``href`` is a ``data:`` URI (nothing else is ever fetched)."""

@@ -242,11 +242,12 @@ def layout_text(
     style: dict[str, str],
     find: Callable[[str], ET.Element | None],
     viewport: tuple[float, float],
-) -> list[TextRun]:
+) -> tuple[list[TextRun], tuple[float, float, float, float] | None]:
     """Lay out a ``<text>`` element (its own computed ``style``) into runs of glyph outlines.
 
     ``find(id)`` returns the element a ``<textPath>`` refers to (or None); percentages are of
-    the ``viewport`` size.
+    the ``viewport`` size.  Also returns the text's box (None: nothing drawn): its glyphs' ink
+    bounds (what librsvg sizes ``objectBoundingBox`` gradients on text with, measured).
     """
     import skia
 
@@ -323,7 +324,13 @@ def layout_text(
             path = skia.Path()
             path.addPath(outline, m)
             runs.append(TextRun(path, st))
-    return runs
+    box = None
+    if runs:
+        bounds = skia.Rect.MakeEmpty()
+        for run in runs:
+            bounds.join(run.path.computeTightBounds())
+        box = (bounds.left(), bounds.top(), bounds.right(), bounds.bottom())
+    return runs, box
 
 
 def _spacing(style: Mapping[str, str], key: str, viewport: tuple[float, float]) -> float:

@@ -1,10 +1,11 @@
-"""Instances painted by gradients (``fill``/``stroke`` ``url(#id)``), drawn one by one by the own renderer.
+"""Instances painted by gradients or clipped (``fill``/``stroke``/``clip-path`` ``url(#id)``), drawn one by one.
 
 A paint server's coordinates are the canvas's (``userSpaceOnUse``) or the painted shape's box
 there (``objectBoundingBox``), as the SVG export writes such instances baked into canvas
 coordinates.  So each one is drawn as its outline mapped by its pose into the canvas, with
 the gradient's shader (:mod:`.paint_servers`) over that outline's box, its stroke width in
-canvas units (times the scale for a ``scaled`` terminal) and its ``opacity`` as a group.
+canvas units (times the scale for a ``scaled`` terminal), its ``opacity`` as a group and
+its clip path (:mod:`.clipping`).
 The fast passes of :mod:`.raster` leave these instances out; :class:`~.kept.Kept` places
 them in the paint order.  Patterns and servers that cannot be found use the fallback colour.
 skia is imported inside the functions.
@@ -19,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from lsys_core.derive.model import Drawing
+from lsys_core.render.clipping import clip_region
 from lsys_core.render.kept_style import group_opacity, shape_paints
 from lsys_core.render.paint_servers import gradient_shader
 from lsys_core.render.paths import _number, parse_style
@@ -28,11 +30,11 @@ __all__ = ["draw_served", "served_instances"]
 
 def _served_style(style: str) -> bool:
     decls = parse_style(style)
-    return any("url(" in decls.get(k, "").lower() for k in ("fill", "stroke"))
+    return any("url(" in decls.get(k, "").lower() for k in ("fill", "stroke", "clip-path"))
 
 
 def served_instances(drawing: Drawing) -> np.ndarray:
-    """Return the indices of the instances whose fill or stroke is a ``url(#id)`` paint."""
+    """Return the indices of the instances whose fill, stroke or clip path is a ``url(#id)``."""
     n = len(drawing)
     if n == 0:
         return np.zeros(0, np.intp)
@@ -86,6 +88,10 @@ def draw_served(
     s, tx, ty = view
     canvas.save()
     canvas.setMatrix(skia.Matrix.MakeAll(s, 0, tx, 0, s, ty, 0, 0, 1))
+    if "url(" in decls.get("clip-path", ""):
+        region = clip_region(decls["clip-path"], find, bbox, viewport)
+        if region is not None:
+            canvas.clipPath(region, skia.ClipOp.kIntersect, True)
     if alpha < 1.0:
         canvas.saveLayerAlpha(None, round(alpha * 255))
     for paint in paints:

@@ -50,3 +50,37 @@ def test_stroke_gradients_and_opacity():
     assert img[40, 100, 3] in range(120, 136)  # half-transparent stroke on the left side
     assert img[40, 100, 0] > 200 and img[40, 139, 2] > 200  # red left, blue right
     assert img[40, 120, 3] == 0  # no fill
+
+
+CLIPS = (
+    '<defs><clipPath id="left" clipPathUnits="userSpaceOnUse"><rect x="0" y="0" width="115" height="100"/></clipPath>'
+    '<clipPath id="half" clipPathUnits="objectBoundingBox"><rect x="0" y="0" width="1" height="0.5"/></clipPath>'
+    '<clipPath id="holes" clipPathUnits="userSpaceOnUse">'
+    '<path d="M0 0 H200 V100 H0 Z M110 30 H130 V50 H110 Z" clip-rule="evenodd"/></clipPath></defs>'
+)
+
+
+def clipped(clip: str):
+    return replace(drawing(f"fill:#000000;clip-path:url(#{clip})"), defs=CLIPS)
+
+
+def test_clip_paths_on_instances():
+    full = render(replace(drawing("fill:#000000"), defs=CLIPS), 200, 100)[..., 3] > 128
+    left = render(clipped("left"), 200, 100)[..., 3] > 128
+    assert full[40, 130] and not left[40, 130] and left[40, 110]  # the big square, cut at x = 115
+    half = render(clipped("half"), 200, 100)[..., 3] > 128
+    assert half[25, 120] and not half[50, 120]  # upper half of its own box (y 20..60) only
+    assert half[12, 20] and not half[25, 20]  # and of the small square's (y 10..30)
+    holes = render(clipped("holes"), 200, 100)[..., 3] > 128
+    assert holes[25, 120] and not holes[40, 120] and holes[55, 120]  # evenodd hole at y 30..50
+
+
+def test_clip_paths_on_kept_text():
+    from lsys_core.grammar.model import Verbatim
+
+    text = '<text x="10" y="70" style="font-size:50px;clip-path:url(#left)">MMMMMM</text>'
+    d = replace(
+        make_drawing([], [], [], [], (0.0, 0.0, 200.0, 100.0)), defs=CLIPS, verbatim=(Verbatim(0, text),)
+    )
+    ink = render(d, 200, 100)[..., 3] > 128
+    assert ink[:, 20:110].any() and not ink[:, 116:].any()
