@@ -12,6 +12,7 @@ its content is known.
 
 from __future__ import annotations
 
+import functools
 import xml.etree.ElementTree as ET
 from collections import Counter
 from dataclasses import dataclass, field, replace
@@ -311,8 +312,7 @@ class Reader:
         if empty and not self._markers_wanted(tag, style, geom):
             self.skips[reason or "degenerate (zero size)"] += 1
             return
-        box = box_of(geom.path)
-        decls = shape_declarations(self.resources, style, ctx, box)
+        decls = shape_declarations(self.resources, style, ctx, functools.cache(lambda: box_of(geom.path)))
         if decls is None:
             return  # clipped out entirely
         stroked = decls.get("stroke", "none") != "none"
