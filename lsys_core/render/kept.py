@@ -45,7 +45,7 @@ from lsys_core.derive.model import Drawing
 from lsys_core.render.clipping import clip_region
 from lsys_core.render.kept_style import computed, group_opacity, lengths, shape_paints, transform_of
 from lsys_core.render.kept_text import layout_text
-from lsys_core.render.paint_servers import gradient_shader
+from lsys_core.render.paint_servers import defs_index, gradient_shader, parse_fragment
 from lsys_core.render.served import draw_served, served_instances
 from lsys_core.render.sizing import default_view
 from lsys_core.svg.tree import href_of, local_name
@@ -132,8 +132,7 @@ class Kept:
             ref = self.refs[k]
             if isinstance(ref, int):
                 if self.terminal is not None:
-                    find = _index(self.defs).get
-                    draw_served(canvas, self.drawing, ref, self.terminal, find, self.viewport, view)
+                    draw_served(canvas, self.drawing, ref, self.terminal, self.defs, self.viewport, view)
                 continue
             picture = _picture(ref, self.defs, self.viewport)
             if picture is None:
@@ -144,33 +143,12 @@ class Kept:
             canvas.restore()
 
 
-def _parse(markup: str) -> ET.Element | None:
-    """Parse fragment markup inside a wrapper (no DTD can occur, so no entity expansion)."""
-    if not markup.strip():
-        return None
-    try:
-        return ET.fromstring(f"<g>{markup}</g>")
-    except ET.ParseError:
-        return None
-
-
-@lru_cache(maxsize=4)
-def _index(defs: str) -> dict[str, ET.Element]:
-    """The elements of a drawing's definitions by id."""
-    root = _parse(defs)
-    out: dict[str, ET.Element] = {}
-    for el in root.iter() if root is not None else ():
-        if el.get("id"):
-            out.setdefault(el.get("id", ""), el)
-    return out
-
-
 @lru_cache(maxsize=PICTURE_CACHE)
 def _picture(markup: str, defs: str, viewport: tuple[float, float]):
     """Record what a kept fragment draws, in document coordinates (None: nothing to draw)."""
     import skia
 
-    root = _parse(markup)
+    root = parse_fragment(markup)
     if root is None:
         return None
     local: dict[str, ET.Element] = {}
@@ -183,7 +161,7 @@ def _picture(markup: str, defs: str, viewport: tuple[float, float]):
         if not ident:
             return None
         found = local.get(ident)
-        return found if found is not None else _index(defs).get(ident)
+        return found if found is not None else defs_index(defs).get(ident)
 
     recorder = skia.PictureRecorder()
     canvas = recorder.beginRecording(skia.Rect.MakeLTRB(-_BIG, -_BIG, _BIG, _BIG))

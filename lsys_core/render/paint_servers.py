@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from collections.abc import Callable
+from functools import lru_cache
 from typing import Any
 
 from lsys_core.render.paths import _number, _rgba, parse_style
 from lsys_core.svg.tree import href_of, local_name
 from lsys_core.svg.values import IDENTITY, Viewport, multiply, parse_length, parse_transform, to_user
 
-__all__ = ["NONE", "gradient_shader", "server_id"]
+__all__ = ["NONE", "defs_index", "gradient_shader", "parse_fragment", "server_id"]
 
 #: What :func:`gradient_shader` returns for a gradient that paints nothing (no stops).
 NONE = "none"
@@ -38,6 +39,30 @@ _DEFAULTS = {
     "fr": "0%",
 }
 _AXIS = {"x1": "x", "x2": "x", "cx": "x", "fx": "x", "y1": "y", "y2": "y", "cy": "y", "fy": "y"}
+
+
+def parse_fragment(markup: str) -> ET.Element | None:
+    """Parse SVG markup (one or more elements) inside a wrapper; None if it is not well-formed.
+
+    No DTD can occur inside the wrapper, so no entity is expanded.
+    """
+    if not markup.strip():
+        return None
+    try:
+        return ET.fromstring(f"<g>{markup}</g>")
+    except ET.ParseError:
+        return None
+
+
+@lru_cache(maxsize=4)
+def defs_index(defs: str) -> dict[str, ET.Element]:
+    """The elements of a drawing's definitions (markup) by id."""
+    root = parse_fragment(defs)
+    out: dict[str, ET.Element] = {}
+    for el in root.iter() if root is not None else ():
+        if el.get("id"):
+            out.setdefault(el.get("id", ""), el)
+    return out
 
 
 def server_id(value: str) -> str | None:

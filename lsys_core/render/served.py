@@ -13,8 +13,8 @@ skia is imported inside the functions.
 
 from __future__ import annotations
 
-import xml.etree.ElementTree as ET
 from collections.abc import Callable
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -22,7 +22,7 @@ import numpy as np
 from lsys_core.derive.model import Drawing
 from lsys_core.render.clipping import clip_region
 from lsys_core.render.kept_style import group_opacity, shape_paints
-from lsys_core.render.paint_servers import gradient_shader
+from lsys_core.render.paint_servers import defs_index, gradient_shader, server_id
 from lsys_core.render.paths import _number, parse_style
 
 __all__ = ["draw_served", "served_instances"]
@@ -47,19 +47,29 @@ def served_instances(drawing: Drawing) -> np.ndarray:
     return np.flatnonzero(served[index])
 
 
+@lru_cache(maxsize=256)
+def _clip(
+    value: str, defs: str, viewport: tuple[float, float], bbox: tuple[float, float, float, float] | None
+):
+    """A clip path's region (cached: instances share their clip paths, redraws repeat them)."""
+    return clip_region(value, defs_index(defs).get, bbox, viewport)
+
+
 def draw_served(
     canvas,
     drawing: Drawing,
     i: int,
     terminal: Callable[[str, str], Any],
-    find: Callable[[str], ET.Element | None],
+    defs: str,
     viewport: tuple[float, float],
     view: tuple[float, float, float],
 ) -> None:
     """Draw instance ``i`` of ``drawing`` with its paint servers, under the view ``(scale, tx, ty)``.
 
-    ``terminal(path, style)`` gives the renderer's cached skia objects of a terminal.
+    ``terminal(path, style)`` gives the renderer's cached skia objects of a terminal; ``defs``
+    is the drawing's definitions markup.
     """
+    find = defs_index(defs).get
     import skia
 
     sym = int(drawing.symbol[i])
@@ -89,7 +99,9 @@ def draw_served(
     canvas.save()
     canvas.setMatrix(skia.Matrix.MakeAll(s, 0, tx, 0, s, ty, 0, 0, 1))
     if "url(" in decls.get("clip-path", ""):
-        region = clip_region(decls["clip-path"], find, bbox, viewport)
+        clip = find(server_id(decls["clip-path"]) or "")
+        boxed = clip is not None and clip.get("clipPathUnits", "").strip() == "objectBoundingBox"
+        region = _clip(decls["clip-path"], defs, viewport, bbox if boxed else None)
         if region is not None:
             canvas.clipPath(region, skia.ClipOp.kIntersect, True)
     if alpha < 1.0:
