@@ -218,7 +218,7 @@ class _Painter:
                 return gradient_shader(value, self.find, bbox, self.viewport)
 
             for run in runs:
-                for paint in shape_paints(run.style, True, servers):
+                for paint in shape_paints(run.style, True, servers, self.viewport):
                     canvas.drawPath(run.path, paint)
         elif tag == "image":
             self.image(el, style)

@@ -20,7 +20,7 @@ from lsys_core.render.paths import _number, _Paints, _rgba, _skia_paint, parse_s
 from lsys_core.svg.style import INHERITED, PROPERTIES, font_size_px
 from lsys_core.svg.values import IDENTITY, Matrix, Viewport, parse_length, parse_transform, to_user
 
-__all__ = ["computed", "font_px", "group_opacity", "lengths", "shape_paints", "transform_of"]
+__all__ = ["computed", "dash_effect", "font_px", "group_opacity", "lengths", "shape_paints", "transform_of"]
 
 #: The initial font size in user units (librsvg's; CSS's ``medium`` would be 16).
 INITIAL_FONT_SIZE = 12.0
@@ -101,11 +101,41 @@ def _colour(style: Mapping[str, str], key: str, default: str, opacity: float):
     return rgba if rgba is not None and rgba[3] > 0 else None
 
 
-def shape_paints(style: Mapping[str, str], antialias: bool = True, servers: Servers | None = None) -> list:
+def _dash_lengths(style: Mapping[str, str], viewport: tuple[float, float]) -> list[float]:
+    text = style.get("stroke-dasharray", "none").strip()
+    values = (lengths(text, style, viewport) if text.lower() != "none" else None) or []
+    return values * 2 if len(values) % 2 else values
+
+
+def dash_effect(style: Mapping[str, str], viewport: tuple[float, float]) -> Any:
+    """The skia dash effect of ``stroke-dasharray``/``stroke-dashoffset`` (None: a solid stroke).
+
+    As SVG says: an odd count of values is repeated, a negative value or a sum of zero draws
+    solid (as does a pattern without gaps); percentages are of the viewport's diagonal.
+    """
+    import skia
+
+    values = _dash_lengths(style, viewport)
+    if not values or min(values) < 0 or not math.isfinite(sum(values)) or sum(values) <= 0:
+        return None
+    if not any(values[1::2]):  # no gaps: a solid stroke (skia would cut its joins)
+        return None
+    offset = lengths(style.get("stroke-dashoffset"), style, viewport)
+    phase = offset[0] % sum(values) if offset and math.isfinite(offset[0]) else 0.0
+    return skia.DashPathEffect.Make(values, phase)
+
+
+def shape_paints(
+    style: Mapping[str, str],
+    antialias: bool = True,
+    servers: Servers | None = None,
+    viewport: tuple[float, float] = (0.0, 0.0),
+) -> list:
     """Return the skia paints of a shape with this style, in its paint order (fill, stroke).
 
     ``servers`` gives the shaders of ``url(#id)`` paints (gradients); without one, or where it
-    has none, the paint's fallback colour is used (none if not given).
+    has none, the paint's fallback colour is used (none if not given).  Strokes are dashed
+    (:func:`dash_effect`; percentages of the ``viewport``).
     """
     width = max(0.0, _number(style.get("stroke-width"), 1.0))
     stroke_geometry = _Paints(
@@ -138,6 +168,11 @@ def shape_paints(style: Mapping[str, str], antialias: bool = True, servers: Serv
         )
         if shader is not None:
             paint.setShader(shader)
+        dashes = dash_effect(style, viewport) if key == "stroke" else None
+        if dashes is not None:
+            if stroke_geometry.cap == "butt" and not any(_dash_lengths(style, viewport)[0::2]):
+                continue  # dashes of length zero with butt caps draw nothing
+            paint.setPathEffect(dashes)
         out.append(paint)
     order = style.get("paint-order", "normal").split()
     stroke_first = order[:1] == ["stroke"] or order[:2] == ["markers", "stroke"]

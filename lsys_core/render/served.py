@@ -1,11 +1,11 @@
-"""Instances painted by gradients or clipped (``fill``/``stroke``/``clip-path`` ``url(#id)``), drawn one by one.
+"""Instances the fast passes cannot draw (gradients, clip paths, dashes, stroke under fill), drawn one by one.
 
 A paint server's coordinates are the canvas's (``userSpaceOnUse``) or the painted shape's box
 there (``objectBoundingBox``), as the SVG export writes such instances baked into canvas
 coordinates.  So each one is drawn as its outline mapped by its pose into the canvas, with
 the gradient's shader (:mod:`.paint_servers`) over that outline's box, its stroke width in
-canvas units (times the scale for a ``scaled`` terminal), its ``opacity`` as a group and
-its clip path (:mod:`.clipping`).
+canvas units (times the scale for a ``scaled`` terminal) and dashed likewise, its
+``paint-order``, its ``opacity`` as a group and its clip path (:mod:`.clipping`).
 The fast passes of :mod:`.raster` leave these instances out; :class:`~.kept.Kept` places
 them in the paint order.  Patterns and servers that cannot be found use the fallback colour.
 skia is imported inside the functions.
@@ -21,20 +21,26 @@ import numpy as np
 
 from lsys_core.derive.model import Drawing
 from lsys_core.render.clipping import clip_region
-from lsys_core.render.kept_style import group_opacity, shape_paints
+from lsys_core.render.kept_style import group_opacity, lengths, shape_paints
 from lsys_core.render.paint_servers import defs_index, gradient_shader, server_id
-from lsys_core.render.paths import _number, parse_style
+from lsys_core.render.paths import parse_style
 
 __all__ = ["draw_served", "served_instances"]
 
 
 def _served_style(style: str) -> bool:
+    """Whether the fast passes cannot draw this style: paint servers, clips, dashes, stroke first."""
     decls = parse_style(style)
-    return any("url(" in decls.get(k, "").lower() for k in ("fill", "stroke", "clip-path"))
+    if any("url(" in decls.get(k, "").lower() for k in ("fill", "stroke", "clip-path")):
+        return True
+    if decls.get("stroke-dasharray", "none").strip().lower() != "none":
+        return True
+    return decls.get("paint-order", "normal").split()[:1] == ["stroke"]
 
 
 def served_instances(drawing: Drawing) -> np.ndarray:
-    """Return the indices of the instances whose fill, stroke or clip path is a ``url(#id)``."""
+    """Return the indices of the instances whose fill, stroke or clip path is a ``url(#id)``, whose
+    stroke is dashed, or whose ``paint-order`` puts the stroke first."""
     n = len(drawing)
     if n == 0:
         return np.zeros(0, np.intp)
@@ -86,12 +92,15 @@ def draw_served(
     bbox = (box.left(), box.top(), box.right(), box.bottom())
     decls = parse_style(css)
     if term.scaled:  # its stroke scales with the instance
-        decls["stroke-width"] = repr(_number(decls.get("stroke-width"), 1.0) * abs(a))
+        for key in ("stroke-width", "stroke-dasharray", "stroke-dashoffset"):
+            values = lengths(decls.get(key), decls, viewport)
+            if values:
+                decls[key] = " ".join(repr(v * abs(a)) for v in values)
 
     def servers(value: str) -> Any:
         return gradient_shader(value, find, bbox, viewport)
 
-    paints = shape_paints(decls, True, servers)
+    paints = shape_paints(decls, True, servers, viewport)
     alpha = group_opacity(decls)
     if not paints or alpha <= 0.0:
         return

@@ -84,3 +84,19 @@ def test_clip_paths_on_kept_text():
     )
     ink = render(d, 200, 100)[..., 3] > 128
     assert ink[:, 20:110].any() and not ink[:, 116:].any()
+
+
+def test_dashes_in_canvas_units_and_stroke_under_fill():
+    line = Terminal("L", "M0 0 L10 0", "fill:none;stroke:#000000;stroke-width:4;stroke-dasharray:10 10")
+    d = make_drawing([line], [0], [15], [25 + 50j], (0.0, 0.0, 200.0, 100.0))  # a line from x 25 to 175
+    row = render(d, 200, 100)[50, :, 3] > 128
+    # Dashes of 10 canvas units (not 150, the instance's scale): on at 25..35, off at 35..45, ...
+    assert row[28:33].all() and not row[38:43].any() and row[48:53].all()
+    assert not render(
+        replace(d, terminals=(replace(line, style=line.style + ";stroke-dasharray:0 10"),)), 200, 100
+    )[..., 3].any()  # zero-length dashes with butt caps draw nothing
+    under = Terminal("U", SQUARE, "fill:#ff0000;stroke:#0000ff;stroke-width:6;paint-order:stroke")
+    img = render(make_drawing([under], [0], [4], [60 + 30j], (0.0, 0.0, 200.0, 100.0)), 200, 100)
+    # The fill covers the inner half of the stroke: red at 1 unit inside the edge, blue outside.
+    assert img[50, 61, 0] > 200 and img[50, 61, 2] < 60
+    assert img[50, 58, 2] > 200 and img[50, 58, 0] < 60
