@@ -15,6 +15,9 @@ from scipy.spatial import cKDTree
 
 __all__ = ["group_indices", "mean_shift"]
 
+#: Points binned at once.
+_BLOCK = 1 << 18
+
 
 def _row_keys(cells: np.ndarray) -> np.ndarray:
     """Hash integer rows to int64 keys (sorting 1-D keys is much faster than ``unique(axis=0)``).
@@ -78,8 +81,11 @@ def mean_shift(
     if n == 1:
         return np.zeros(1, int), pts.copy()
     # Bin seeding on half-bandwidth cells: weighted centroids of occupied cells.
-    cells = np.floor(pts * 2.0).astype(np.int64)
-    _, inv, counts = np.unique(_row_keys(cells), return_inverse=True, return_counts=True)
+    keys = np.concatenate(
+        [_row_keys(np.floor(pts[lo : lo + _BLOCK] * 2.0).astype(np.int64)) for lo in range(0, n, _BLOCK)]
+    )  # in blocks: three temporaries of the size of the points for 6·10^6 points were 0.7 GiB
+    _, inv, counts = np.unique(keys, return_inverse=True, return_counts=True)
+    del keys
     inv = inv.ravel()
     cent = np.zeros((counts.size, pts.shape[1]))
     np.add.at(cent, inv, pts)

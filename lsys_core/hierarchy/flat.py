@@ -265,12 +265,19 @@ def greedy_sets(offsets: np.ndarray, items: np.ndarray, order: np.ndarray) -> np
     owner = np.repeat(np.arange(count, dtype=np.int64), lengths)[live]
     items = np.asarray(items, np.int64)[live]
     # Entries sorted by item, then by the rank of their set: per item, the sets in greedy order.
-    e_key = np.sort(items * np.int64(count) + rank[owner])
+    e_key = items * np.int64(count)
+    e_key += rank[owner]
+    del live, owner, items  # entry-sized arrays are held only while needed (10^7 entries at 60k elements)
+    e_key.sort()
     e_item = e_key // count
-    e_set = order[e_key % count]
+    e_key %= count
+    e_set = order[e_key]
+    del e_key
     cut = np.flatnonzero(e_item[1:] != e_item[:-1]) + 1
+    del e_item
+    n_entries = e_set.size
     starts = np.concatenate([[0], cut])
-    ends = np.concatenate([cut, [e_item.size]])
+    ends = np.concatenate([cut, [n_entries]])
     end_of = np.repeat(ends, ends - starts)  # per entry: end of its item's run
     head = np.zeros(e_set.size, bool)
     head[starts] = True  # entries that are their item's first undecided set

@@ -81,6 +81,7 @@ def linear_candidates(
         if abs(dA) < tol.angle and abs(dB) < tol.angle:
             continue  # constant transform: a cluster C already covers it
         problems.append((e1[g2], e2[g2], dA, dB))
+    del emb2, lab2, e1, e2, cluster, da, db  # millions of consecutive pairs at 50,000 elements
     return _linear_chains(ctx, sym, ps, problems, prox)
 
 

@@ -88,3 +88,31 @@ def test_cli_jobs_option_and_variable(tmp_path) -> None:
     env["LSYS_JOBS"] = "many"
     bad = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=env)
     assert bad.returncode != 0 and bad.stderr.count("\n") == 1 and "LSYS_JOBS" in bad.stderr
+
+
+def test_linear_sequences_taking_turns_give_the_same_rules(restore_jobs, monkeypatch) -> None:
+    from lsys_core.hierarchy import analysis
+
+    grid = _rotating_grid(6, 9)
+    parallel.set_jobs(2)
+    beside = format_grammar(infer(grid).grammar)
+    monkeypatch.setattr(analysis, "BESIDE_PAIRS", 0)  # as a scene of millions of pairs does
+    assert format_grammar(infer(grid).grammar) == beside
+
+
+def test_mean_shift_binned_in_blocks_is_the_same(monkeypatch) -> None:
+    from lsys_core.hierarchy import clustering
+
+    pts = np.random.default_rng(3).normal(size=(500, 3)) * 3.0
+    whole = clustering.mean_shift(pts)
+    monkeypatch.setattr(clustering, "_BLOCK", 7)
+    blocks = clustering.mean_shift(pts)
+    np.testing.assert_array_equal(blocks[0], whole[0])
+    np.testing.assert_array_equal(blocks[1], whole[1])
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc malloc arenas")
+def test_one_malloc_arena_is_asked_for_on_glibc() -> None:
+    import platform
+
+    assert (platform.libc_ver()[0] == "glibc") == parallel.ONE_ARENA
