@@ -13,6 +13,7 @@ CHECKS = {"svg": check_svg_import, "lsys": check_lsys_text, "css": check_css_tex
 CASES = sorted(FINDINGS.glob("*.input")) if FINDINGS.is_dir() else []
 
 
+@pytest.mark.filterwarnings("error::RuntimeWarning")  # as the fuzzer counts them: noise on stderr
 @pytest.mark.parametrize("path", CASES, ids=[p.stem for p in CASES])
 def test_fuzz_finding_stays_fixed(path: Path) -> None:
     target = path.stem.split("-", 1)[0]
