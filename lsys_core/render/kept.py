@@ -89,6 +89,7 @@ class Kept:
         ]
         self.served = served
         self.drawing, self.terminal, self.defs = drawing, terminal, drawing.defs
+        self._styles: tuple[tuple[str, ...], np.ndarray] | None = None
         _, _, w, h = default_view(drawing)
         self.viewport = (float(w), float(h))  # what percentages refer to
 
@@ -123,6 +124,19 @@ class Kept:
             if p in cuts:
                 yield "kept", p, p, cuts[p]
 
+    def _served(self, canvas, i: int, view: tuple[float, float, float]) -> None:
+        """Draw instance ``i``, painted by a gradient (see :mod:`.served`)."""
+        assert self.terminal is not None
+        if self._styles is None:
+            self._styles = self.drawing.instance_styles()
+        styles, style = self._styles
+        d, sym, k = self.drawing, int(self.drawing.symbol[i]), int(style[i])
+        if 0 <= sym < len(d.terminals) and 0 <= k < len(styles):
+            a, b = complex(d.a[i]), complex(d.b[i])
+            draw_served(
+                canvas, d.terminals[sym], styles[k], a, b, self.terminal, self.defs, self.viewport, view
+            )
+
     def draw(self, canvas, items: list[int] | None, view: tuple[float, float, float]) -> None:
         """Draw the ``items`` (all: None) under the view ``(scale, tx, ty)``."""
         import skia
@@ -132,7 +146,7 @@ class Kept:
             ref = self.refs[k]
             if isinstance(ref, int):
                 if self.terminal is not None:
-                    draw_served(canvas, self.drawing, ref, self.terminal, self.defs, self.viewport, view)
+                    self._served(canvas, ref, view)
                 continue
             picture = _picture(ref, self.defs, self.viewport)
             if picture is None:

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from lsys_core.derive.model import Drawing
+from lsys_core.grammar.model import Terminal
 from lsys_core.render.clipping import clip_region
 from lsys_core.render.kept_style import group_opacity, lengths, shape_paints
 from lsys_core.render.paint_servers import defs_index, gradient_shader, server_id
@@ -61,46 +62,53 @@ def _clip(
     return clip_region(value, defs_index(defs).get, bbox, viewport)
 
 
+@lru_cache(maxsize=1024)
+def _plain(css: str, scale: float, viewport: tuple[float, float]) -> tuple[dict[str, str], tuple]:
+    """A style's declarations (lengths times ``scale``) and, without paint servers, its paints."""
+    decls = parse_style(css)
+    if scale != 1.0:  # a scaled terminal: its stroke scales with the instance
+        for key in ("stroke-width", "stroke-dasharray", "stroke-dashoffset"):
+            values = lengths(decls.get(key), decls, viewport)
+            if values:
+                decls[key] = " ".join(repr(v * scale) for v in values)
+    served = any("url(" in decls.get(k, "") for k in ("fill", "stroke"))
+    return decls, () if served else tuple(shape_paints(decls, True, None, viewport))
+
+
 def draw_served(
     canvas,
-    drawing: Drawing,
-    i: int,
+    term: Terminal,
+    css: str,
+    a: complex,
+    b: complex,
     terminal: Callable[[str, str], Any],
     defs: str,
     viewport: tuple[float, float],
     view: tuple[float, float, float],
 ) -> None:
-    """Draw instance ``i`` of ``drawing`` with its paint servers, under the view ``(scale, tx, ty)``.
+    """Draw an instance of ``term`` in style ``css`` at pose ``(a, b)`` under the view ``(scale, tx, ty)``.
 
     ``terminal(path, style)`` gives the renderer's cached skia objects of a terminal; ``defs``
-    is the drawing's definitions markup.
+    is the drawing's definitions markup.  Paints without paint servers are cached per style.
     """
-    find = defs_index(defs).get
     import skia
 
-    sym = int(drawing.symbol[i])
-    styles, style = drawing.instance_styles()
-    if not (0 <= sym < len(drawing.terminals)) or not (0 <= int(style[i]) < len(styles)):
-        return
-    a, b = complex(drawing.a[i]), complex(drawing.b[i])
     if not (np.isfinite(a) and np.isfinite(b)):
         return
-    term, css = drawing.terminals[sym], styles[int(style[i])]
+    find = defs_index(defs).get
     path = skia.Path(terminal(term.path, css).path)
     path.transform(skia.Matrix.MakeAll(a.real, -a.imag, b.real, a.imag, a.real, b.imag, 0, 0, 1))
-    box = path.computeTightBounds()
-    bbox = (box.left(), box.top(), box.right(), box.bottom())
-    decls = parse_style(css)
-    if term.scaled:  # its stroke scales with the instance
-        for key in ("stroke-width", "stroke-dasharray", "stroke-dashoffset"):
-            values = lengths(decls.get(key), decls, viewport)
-            if values:
-                decls[key] = " ".join(repr(v * abs(a)) for v in values)
+    decls, paints = _plain(css, abs(a) if term.scaled else 1.0, viewport)
+    bbox = (0.0, 0.0, 0.0, 0.0)
+    if "url(" in css:  # paint servers and clip paths may need the box
+        box = path.computeTightBounds()
+        bbox = (box.left(), box.top(), box.right(), box.bottom())
+    if any("url(" in decls.get(k, "") for k in ("fill", "stroke")):
 
-    def servers(value: str) -> Any:
-        return gradient_shader(value, find, bbox, viewport)
+        def servers(value: str) -> Any:
+            return gradient_shader(value, find, bbox, viewport)
 
-    paints = shape_paints(decls, True, servers, viewport)
+        paints = tuple(shape_paints(decls, True, servers, viewport))
     alpha = group_opacity(decls)
     if not paints or alpha <= 0.0:
         return

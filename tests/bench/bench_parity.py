@@ -13,8 +13,8 @@ all at the same size (longest side ``--side`` pixels), and print per file the sh
 pixels (alpha >= 128 in either image) whose colour or coverage differs from the input's rendering
 (any channel by more than 32 of 255).  Target: <= 2 % for both.  The project's own renderer
 draws content kept as is (text laid out with fontconfig's faces, ``data:`` images) and
-gradient paints at their places in the paint order (``lsys_core.render.kept``); what it does
-not draw (patterns, clip paths, masks, filters, dashes) shows up as a difference.  Needs rsvg-convert (Debian:
+gradients, clip paths and dashes, at their places in the paint order (``lsys_core.render.kept``);
+what it does not draw (patterns, masks, filters) shows up as a difference.  Needs rsvg-convert (Debian:
 librsvg2-bin).
 """
 
