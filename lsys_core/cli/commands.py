@@ -110,24 +110,33 @@ def _infer_nothing(args, scene, head, outputs: list, symmetrize: bool) -> int:
     grammar = _empty_grammar(scene)
     text = format_grammar(grammar)
     drawing = _derive(grammar)
+
+    def report() -> dict:
+        rep = {"elements": 0, "symbols": 1, "terminals": 0, "rules": ["Z -> ε"], "axiom": "Z"}
+        rep.update(derived_elements=len(drawing), warnings=list(scene.warnings))
+        return rep
+
+    _commit(_infer_files(args, text, drawing, report, outputs, symmetrize, head))
+    return 0
+
+
+def _infer_files(args, text: str, drawing, report, outputs: list, symmetrize: bool, head) -> Files:
+    """What ``infer`` (or ``symmetrize``) writes: rules, drawings and the report (``report()``)."""
     files: Files = []
     if symmetrize:
         files += _drawing_outputs(drawing, args.output, None, {}, flat=args.flat, head=head)
         if args.rules:
             files.append((args.rules, text))
-    else:
-        if args.output:
-            files.append((args.output, text))
-        png = getattr(args, "png", None)
-        files += _drawing_outputs(drawing, args.svg, png, _png_options(args), flat=args.flat, head=head)
-        if args.report:
-            rep = {"elements": 0, "symbols": 1, "terminals": 0, "rules": ["Z -> ε"], "axiom": "Z"}
-            rep.update(derived_elements=len(drawing), warnings=list(scene.warnings))
-            files.append((args.report, json.dumps(rep, indent=1, ensure_ascii=False) + "\n"))
-        if not args.output and not args.report and STDIO not in outputs:
-            files.append((STDIO, text))
-    _commit(files)
-    return 0
+        return files
+    if args.output:
+        files.append((args.output, text))
+    png = getattr(args, "png", None)
+    files += _drawing_outputs(drawing, args.svg, png, _png_options(args), flat=args.flat, head=head)
+    if args.report:
+        files.append((args.report, json.dumps(report(), indent=1, ensure_ascii=False) + "\n"))
+    if not args.output and not args.report and STDIO not in outputs:
+        files.append((STDIO, text))
+    return files
 
 
 def _load_rules(path: str):
@@ -321,7 +330,7 @@ def _cmd_infer(args, progress: Progress, say: Say, symmetrize: bool = False) -> 
     outputs = [args.output, args.rules] if symmetrize else [args.output, args.svg, png, args.report]
     _check(outputs, [args.input])
     settings = _settings(args)
-    png_options = _png_options(args)
+    _png_options(args)  # a bad PNG option fails before the inference, not after
     t0 = time.perf_counter()
     scene, head = _read_svg(args.input)
     t_import = time.perf_counter() - t0
@@ -338,22 +347,13 @@ def _cmd_infer(args, progress: Progress, say: Say, symmetrize: bool = False) -> 
     result.stages["derivation"] = time.perf_counter() - t
     progress.close()
     text = format_grammar(result.grammar)
-    files: Files = []
-    if symmetrize:
-        files += _drawing_outputs(drawing, args.output, None, {}, flat=args.flat, head=head)
-        if args.rules:
-            files.append((args.rules, text))
-    else:
-        if args.output:
-            files.append((args.output, text))
-        files += _drawing_outputs(drawing, args.svg, png, png_options, flat=args.flat, head=head)
-        if args.report:
-            rep = _infer_report(result, scene, drawing)
-            rep["seconds"] = round(time.perf_counter() - t0, 4)
-            files.append((args.report, json.dumps(rep, indent=1, ensure_ascii=False) + "\n"))
-        if not args.output and not args.report and STDIO not in outputs:
-            files.append((STDIO, text))
-    _commit(files)
+
+    def report() -> dict:
+        rep = _infer_report(result, scene, drawing)
+        rep["seconds"] = round(time.perf_counter() - t0, 4)
+        return rep
+
+    _commit(_infer_files(args, text, drawing, report, outputs, symmetrize, head))
     if not args.quiet:
         say(_summary(result, scene))
     if args.verbose:
