@@ -12,6 +12,7 @@ SVG, which librsvg 2.54 ignores, as it does in the input).
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 
 import numpy as np
 
@@ -19,7 +20,7 @@ from lsys_core.geometry.bezier import transform_cubics
 from lsys_core.geometry.paths import d_from_cubics
 from lsys_core.svg.clipregion import Region, intersect_regions, piece_region, region_d, union_regions
 from lsys_core.svg.paint import split_url
-from lsys_core.svg.resources import Box, Resources, _box_matrix, _esc, _f
+from lsys_core.svg.resources import Box, Resources, _box_matrix, _esc, _f, no_area, unit_rect
 from lsys_core.svg.tree import href_of, local_name, shown
 from lsys_core.svg.values import IDENTITY, Matrix, Viewport, multiply, parse_length, parse_transform, to_user
 from lsys_core.svg.verbatim import matrix_text, style_text, subtree_markup
@@ -38,25 +39,45 @@ class Definitions(Resources):
 
     def clip(self, value: str | None, ctm: Matrix, bbox: Box | None, vp: Viewport) -> str | None:
         """Rewrite a ``clip-path`` value for an element: an id, None (no clipping) or :data:`EMPTY`."""
+        return self._referenced(value, "clipPath", ctm, bbox, vp, self._clip, self._clip_cycle)
+
+    def _clip_cycle(self, value: str) -> None:
+        """Note and ignore a clip-path reference that closes a cycle."""
+        # The reference that closes a cycle (a clip path clipped by itself, directly or through
+        # its children) is ignored, as renderers draw it: the cycle is cut there.
+        self.notes.append(
+            f"ignored the clip-path {shown(value)}: it refers back to itself (a reference cycle)"
+        )
+
+    def _referenced(
+        self,
+        value: str | None,
+        tag: str,
+        ctm: Matrix,
+        bbox: Box | None,
+        vp: Viewport,
+        build: Callable[[ET.Element, Matrix, Box | None, Viewport], str | None],
+        cycle: Callable[[str], str | None],
+    ) -> str | None:
+        """``build(target, ctm, bbox, vp)`` for the ``tag`` element that ``value`` (a ``url()``) names.
+
+        None when it names none (or ``none``); each result is cached per target, transform and
+        box; a reference back into a target being built gives ``cycle(value)``.
+        """
         if value is None or value.strip().lower() == "none":
             return None
         ref, _ = split_url(value)
         target = self.tree.target(ref)
-        if target is None or local_name(target.tag) != "clipPath":
+        if target is None or local_name(target.tag) != tag:
             return None
-        key = ("clip", id(target), ctm, bbox)
+        key = (tag, id(target), ctm, bbox)
         if key in self._cache:
             return self._cache[key]  # type: ignore[return-value]
         if id(target) in self._busy:
-            # The reference that closes a cycle (a clip path clipped by itself, directly or through
-            # its children) is ignored, as renderers draw it: the cycle is cut there.
-            self.notes.append(
-                f"ignored the clip-path {shown(value)}: it refers back to itself (a reference cycle)"
-            )
-            return None
+            return cycle(value)
         self._busy.add(id(target))
         try:
-            got = self._clip(target, ctm, bbox, vp)
+            got = build(target, ctm, bbox, vp)
         finally:
             self._busy.discard(id(target))
         self._cache[key] = got
@@ -64,7 +85,7 @@ class Definitions(Resources):
 
     def _clip(self, el: ET.Element, ctm: Matrix, bbox: Box | None, vp: Viewport) -> str | None:
         obb = (el.get("clipPathUnits") or "").strip() == "objectBoundingBox"
-        if obb and (bbox is None or bbox[2] <= 0 or bbox[3] <= 0):
+        if obb and no_area(bbox):
             return EMPTY
         base = multiply(ctm, _box_matrix(bbox)) if obb and bbox else ctm
         base = multiply(base, parse_transform(el.get("transform")) or IDENTITY)
@@ -186,47 +207,15 @@ class Definitions(Resources):
 
     def mask(self, value: str | None, ctm: Matrix, bbox: Box | None, vp: Viewport) -> str | None:
         """Rewrite a ``mask`` value for an element: an id, None (no mask) or :data:`EMPTY`."""
-        if value is None or value.strip().lower() == "none":
-            return None
-        ref, _ = split_url(value)
-        target = self.tree.target(ref)
-        if target is None or local_name(target.tag) != "mask":
-            return None
-        key = ("mask", id(target), ctm, bbox)
-        if key in self._cache:
-            return self._cache[key]  # type: ignore[return-value]
-        if id(target) in self._busy:
-            return EMPTY
-        self._busy.add(id(target))
-        try:
-            got = self._mask(target, ctm, bbox, vp)
-        finally:
-            self._busy.discard(id(target))
-        self._cache[key] = got
-        return got
+        return self._referenced(value, "mask", ctm, bbox, vp, self._mask, lambda _: EMPTY)
 
     def _mask(self, el: ET.Element, ctm: Matrix, bbox: Box | None, vp: Viewport) -> str | None:
         obb = (el.get("maskUnits") or "objectBoundingBox").strip() != "userSpaceOnUse"
         content_obb = (el.get("maskContentUnits") or "").strip() == "objectBoundingBox"
-        if (obb or content_obb) and (bbox is None or bbox[2] <= 0 or bbox[3] <= 0):
+        if (obb or content_obb) and no_area(bbox):
             return EMPTY
-        unit_vp = Viewport(1.0, 1.0, vp.font_size, vp.root_font_size)
-        region = []
-        for name, axis, default in (
-            ("x", "x", "-10%"),
-            ("y", "y", "-10%"),
-            ("width", "x", "120%"),
-            ("height", "y", "120%"),
-        ):
-            got = parse_length(el.get(name) or default) or parse_length(default)
-            region.append(to_user(got, unit_vp if obb else vp, axis))  # type: ignore[arg-type]
-        if obb and bbox:
-            region = [
-                bbox[0] + region[0] * bbox[2],
-                bbox[1] + region[1] * bbox[3],
-                region[2] * bbox[2],
-                region[3] * bbox[3],
-            ]
+        texts = tuple(el.get(n) for n in ("x", "y", "width", "height"))
+        region = unit_rect(texts, ("-10%", "-10%", "120%", "120%"), obb, bbox, vp)
         if region[2] <= 0 or region[3] <= 0:
             return EMPTY
         corners = [complex(region[0] + dx, region[1] + dy) for dx in (0, region[2]) for dy in (0, region[3])]

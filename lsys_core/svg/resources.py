@@ -43,6 +43,34 @@ def _box_matrix(box: Box) -> Matrix:
     return (box[2], 0.0, 0.0, box[3], box[0], box[1])
 
 
+def no_area(bbox: Box | None) -> bool:
+    """Whether there is no bounding box with area to map ``objectBoundingBox`` units onto."""
+    return bbox is None or bbox[2] <= 0 or bbox[3] <= 0
+
+
+def unit_rect(
+    texts: tuple[str | None, ...], defaults: tuple[str, ...], obb: bool, bbox: Box | None, vp: Viewport
+) -> list[float]:
+    """``x, y, width, height`` of a region (a pattern tile, a mask) in user units.
+
+    With ``obb`` the lengths are fractions (or percentages) of ``bbox``; otherwise user lengths
+    in the viewport ``vp``.  Missing or unreadable values take their ``defaults``.
+    """
+    unit_vp = Viewport(1.0, 1.0, vp.font_size, vp.root_font_size)
+    rect = []
+    for text, default, axis in zip(texts, defaults, "xyxy", strict=True):
+        got = parse_length(text or default) or parse_length(default)
+        rect.append(to_user(got, unit_vp if obb else vp, axis))  # type: ignore[arg-type]
+    if obb and bbox:
+        rect = [
+            bbox[0] + rect[0] * bbox[2],
+            bbox[1] + rect[1] * bbox[3],
+            rect[2] * bbox[2],
+            rect[3] * bbox[3],
+        ]
+    return rect
+
+
 def _f(v: float) -> str:
     return f"{v:.10g}"
 
@@ -183,7 +211,7 @@ class Resources:
             return ("color", color, opacity)
         units = (self._attr(chain, "gradientUnits") or "objectBoundingBox").strip()
         obb = units != "userSpaceOnUse"
-        if obb and (bbox is None or bbox[2] <= 0 or bbox[3] <= 0):
+        if obb and no_area(bbox):
             return "missing"  # no box to map onto: the fallback paint applies (as renderers draw)
         gt = parse_transform(self._attr(chain, "gradientTransform")) or IDENTITY
         m = multiply(multiply(ctm, _box_matrix(bbox)), gt) if obb and bbox else multiply(ctm, gt)
@@ -251,20 +279,10 @@ class Resources:
         units = (self._attr(chain, "patternUnits") or "objectBoundingBox").strip()
         content_units = (self._attr(chain, "patternContentUnits") or "userSpaceOnUse").strip()
         obb = units != "userSpaceOnUse"
-        if (obb or content_units == "objectBoundingBox") and (bbox is None or bbox[2] <= 0 or bbox[3] <= 0):
+        if (obb or content_units == "objectBoundingBox") and no_area(bbox):
             return "missing"  # no box to map onto: the fallback paint applies (as renderers draw)
-        unit_vp = Viewport(1.0, 1.0, vp.font_size, vp.root_font_size)
-        tile = []
-        for name, axis in (("x", "x"), ("y", "y"), ("width", "x"), ("height", "y")):
-            got = parse_length(self._attr(chain, name) or "0")
-            tile.append(0.0 if got is None else to_user(got, unit_vp if obb else vp, axis))
-        if obb and bbox:
-            tile = [
-                bbox[0] + tile[0] * bbox[2],
-                bbox[1] + tile[1] * bbox[3],
-                tile[2] * bbox[2],
-                tile[3] * bbox[3],
-            ]
+        names = ("x", "y", "width", "height")
+        tile = unit_rect(tuple(self._attr(chain, n) for n in names), ("0",) * 4, obb, bbox, vp)
         if tile[2] <= 0 or tile[3] <= 0:
             return None
         content_el = next((c for c in chain if any(isinstance(k.tag, str) for k in c)), None)
