@@ -20,7 +20,7 @@ from lsys_core.hierarchy.nodes import Nodes
 from lsys_core.hierarchy.snap import plainer, snapped
 from lsys_core.settings import setting
 
-__all__ = ["WEAK_COVER", "Measure", "Weights", "choose", "scores", "worthwhile"]
+__all__ = ["WEAK_COVER", "Measure", "Weights", "choose", "importance_order", "scores", "worthwhile"]
 
 #: ``measure(elements, a, b)``: how far input elements would be from their terminals drawn at poses ``a, b``.
 Measure = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
@@ -123,6 +123,20 @@ def scores(cands: list[Candidate], w: Weights) -> np.ndarray:
     )
 
 
+def importance_order(cands: list[Candidate], weights: Weights) -> tuple[np.ndarray, list[int]]:
+    """Rounded importance of every candidate, and the candidates most important first.
+
+    Ties go to the candidate that covers more, then to the one that comes first in the drawing.
+    """
+    score = np.round(scores(cands, weights), 9)
+    order = sorted(
+        range(len(cands)),
+        key=lambda i: (score[i], cands[i].covered, -cands[i].start[0], -cands[i].start[1]),
+        reverse=True,
+    )
+    return score, order
+
+
 def choose(
     cands: list[Candidate],
     weights: Weights,
@@ -138,12 +152,7 @@ def choose(
     worthwhile candidate on disjoint nodes is applied in the same level, so the number of
     levels stays small.  Only the candidates looked at are tested.
     """
-    score = np.round(scores(cands, weights), 9)
-    order = sorted(
-        range(len(cands)),
-        key=lambda i: (score[i], cands[i].covered, -cands[i].start[0], -cands[i].start[1]),
-        reverse=True,
-    )
+    score, order = importance_order(cands, weights)
     taken = np.zeros(n_nodes, bool)
     out: list[Candidate] = []
     k = 0

@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from lsys_core.hierarchy.candidates import Candidate, SeqCandidate
-from lsys_core.hierarchy.select import WEAK_COVER, Weights, choose, scores
+from lsys_core.hierarchy.select import WEAK_COVER, Weights, choose, importance_order
 
 
 def _reference(
@@ -24,12 +24,7 @@ def _reference(
     worthwhile: Callable[[Candidate], Candidate | None],
 ) -> list[Candidate]:
     """The candidate choice with each tie group found by a scan of the rest of the order."""
-    score = np.round(scores(cands, weights), 9)
-    order = sorted(
-        range(len(cands)),
-        key=lambda i: (score[i], cands[i].covered, -cands[i].start[0], -cands[i].start[1]),
-        reverse=True,
-    )
+    score, order = importance_order(cands, weights)  # the same order: only the tie groups differ
     taken = np.zeros(n_nodes, bool)
     out: list[Candidate] = []
     k = 0

@@ -14,15 +14,13 @@ import pytest
 from lsys_core.geometry import cubics_from_d
 from lsys_core.svg import parse_svg
 
+from .svg_reading import clip_box, style_of
+
 NS = 'xmlns="http://www.w3.org/2000/svg"'
 
 
 def svg(body: str, attrs: str = 'width="100" height="100" viewBox="0 0 100 100"') -> str:
     return f'<svg {NS} xmlns:xlink="http://www.w3.org/1999/xlink" {attrs}>{body}</svg>'
-
-
-def style_of(element) -> dict[str, str]:
-    return dict(p.split(":", 1) for p in element.style.split(";") if p)
 
 
 def test_paint_order_keywords_left_out_follow_in_default_order():
@@ -77,11 +75,7 @@ def test_hidden_shapes_count_in_a_group_bounding_box():
     )
     scene = parse_svg(text)
     (el,) = scene.elements
-    ref = style_of(el)["clip-path"]
-    defs = ET.fromstring(f'<defs xmlns="http://www.w3.org/2000/svg">{scene.defs}</defs>')
-    (clip,) = [c for c in defs if "url(#" + c.get("id") + ")" == ref]
-    c, _, _ = cubics_from_d(clip[0].get("d"))
-    assert (c.real.min(), c.real.max(), c.imag.min(), c.imag.max()) == pytest.approx((0, 50, 0, 100))
+    assert clip_box(scene, el) == pytest.approx((0, 50, 0, 100))
 
 
 def test_bounding_box_paint_on_a_shape_without_area_uses_the_fallback():

@@ -16,6 +16,8 @@ from lsys_core.geometry import cubics_from_d, sample_cubics, sample_uniform
 from lsys_core.svg import load_svg, parse_svg
 from lsys_core.svg.tree import local_name
 
+from .svg_reading import clip_box, style_of
+
 SHARED = Path(__file__).resolve().parents[2].parent / "shared"
 NS = 'xmlns="http://www.w3.org/2000/svg"'
 DRAWABLE = {"path", "rect", "circle", "ellipse", "line", "polyline", "polygon"}
@@ -35,10 +37,6 @@ def shared() -> Path:
 
 def svg(body: str, attrs: str = 'width="100" height="100" viewBox="0 0 100 100"') -> str:
     return f'<svg {NS} xmlns:xlink="http://www.w3.org/1999/xlink" {attrs}>{body}</svg>'
-
-
-def style_of(element) -> dict[str, str]:
-    return dict(p.split(":", 1) for p in element.style.split(";") if p)
 
 
 def _count_drawables(path: Path) -> int:
@@ -604,11 +602,7 @@ def test_clip_paths_are_rewritten_in_document_coordinates():
         '<rect x="10" y="0" width="20" height="10" clip-path="url(#c)"/>'
     )
     scene = parse_svg(text)
-    ref = style_of(scene.elements[0])["clip-path"]
-    defs = ET.fromstring(f'<defs xmlns="http://www.w3.org/2000/svg">{scene.defs}</defs>')
-    (clip,) = [c for c in defs if "url(#" + c.get("id") + ")" == ref]
-    c, _, _ = cubics_from_d(clip[0].get("d"))
-    assert (c.real.min(), c.real.max(), c.imag.min(), c.imag.max()) == pytest.approx((10, 20, 0, 10))
+    assert clip_box(scene, scene.elements[0]) == pytest.approx((10, 20, 0, 10))
 
 
 def test_illustrator_entities_are_accepted():
