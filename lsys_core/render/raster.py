@@ -221,7 +221,7 @@ class Renderer:
             else:
                 hl = hl.astype(np.intp)
                 mask[hl[(hl >= 0) & (hl < n)]] = True
-            self._draw_highlight(terms, symbol, da, db, visible & mask, antialias and not draft)
+            self._draw_highlight(terms, symbol, da, db, visible & mask, antialias, draft)
         canvas.resetMatrix()
         return self._pixels
 
@@ -287,10 +287,10 @@ class Renderer:
 
     _batch_path = staticmethod(batch_path)
 
-    def _draw_highlight(self, terms, symbol, da, db, mask, antialias: bool) -> None:
+    def _draw_highlight(self, terms, symbol, da, db, mask, antialias: bool, draft: bool) -> None:
         """Draw the selected instances on top in the highlight colour."""
         self._canvas.resetMatrix()
-        draw_highlight(self._canvas, terms, symbol, da, db, mask, antialias)
+        draw_highlight(self._canvas, terms, symbol, da, db, mask, antialias, draft)
 
 
 def _unpremultiply(pixels: np.ndarray) -> np.ndarray:

@@ -111,6 +111,10 @@ def test_highlight_colours_selected_instances():
     mask_img = render(dr, 100, 100, highlight=np.array([True, False]))
     assert mask_img[20, 20, 0] > 100 and tuple(mask_img[20, 70, :3]) == (0, 0, 0)
     assert HIGHLIGHT[0] == 255
+    draft = render(dr, 100, 100, highlight=np.array([1]), draft=True)  # batched outlines, hairline
+    assert tuple(draft[20, 20, :3]) == (0, 0, 0)
+    r, _, b = draft[20, 70, :3].astype(int)
+    assert r > 100 and r > b
 
 
 def test_culling_and_empty_drawing():
