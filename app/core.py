@@ -33,6 +33,7 @@ __all__ = [
     "replace_terminal",
     "replace_with_terminal",
     "restyle_terminal",
+    "rule_closures",
     "rules_under",
     "set_param",
     "set_params",
@@ -149,6 +150,13 @@ def rules_under(grammar: Any, name: str) -> set[str]:
     from lsys_core.grammar.semantics import rules_under as _under
 
     return _under(grammar, name)
+
+
+def rule_closures(grammar: Any) -> dict[str, frozenset[str]]:
+    """Return :func:`rules_under` of ``axiom`` and every rule, read in one pass."""
+    from lsys_core.grammar.semantics import rule_closures as _closures
+
+    return _closures(grammar)
 
 
 def find_handles(grammar: Any, drawing: Any, index: int, knob: float) -> Any:

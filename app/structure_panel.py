@@ -34,6 +34,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from . import core
 from .rules_view import thumbnail
 
 __all__ = ["StructurePanel"]
@@ -74,6 +75,7 @@ class StructurePanel(QWidget):
         self._items: dict[str, list[QTreeWidgetItem]] = {}
         self._tree_key: tuple = ()
         self._palette_key: tuple = ()
+        self._closures: tuple[Any, dict[str, frozenset[str]]] = (None, {})  # (grammar, rule_closures)
         self._updating = False
         self.tree = QTreeWidget(self)
         self.tree.setHeaderLabels(["Rule", "Draws", "Instances"])
@@ -202,13 +204,14 @@ class StructurePanel(QWidget):
         """Show how many instances each rule's structure draws (its own and its sub-rules')."""
         if self.grammar is None or drawing is None:
             return
-        from . import core
-
+        if self._closures[0] is not self.grammar:
+            self._closures = (self.grammar, core.rule_closures(self.grammar))
+        under = self._closures[1]
         rules = self.grammar.rules
         counts = np.bincount(np.asarray(drawing.rule, dtype=np.int64) + 1, minlength=len(rules) + 1)
         own = {r.name: int(counts[i + 1]) for i, r in enumerate(rules)}
         for name, items in self._items.items():
-            n = sum(own.get(r, 0) for r in core.rules_under(self.grammar, name))
+            n = sum(own.get(r, 0) for r in under.get(name, ()))
             n += int(counts[0]) if name == "axiom" else 0
             for item in items:
                 item.setText(2, f"{n:,}")

@@ -15,13 +15,13 @@ the argument of every call of the rule with that count, and a step repeated in t
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 
 from lsys_core.grammar.model import COND_EQ0, Grammar, Module, Rule, Symbol
 from lsys_core.grammar.runs import Control, Op, Write, merge, runs, sequence_words, signature, step_controls
 
-__all__ = ["Card", "Control", "Write", "describe", "rules_under"]
+__all__ = ["Card", "Control", "Write", "describe", "rule_closures", "rules_under"]
 
 
 @dataclass(frozen=True)
@@ -189,12 +189,25 @@ def rules_under(g: Grammar, name: str) -> set[str]:
 
     ``name`` is a rule name or ``axiom`` (then every rule reachable from the start).
     """
+    return set(rule_closures(g, (name,))[name])
+
+
+def rule_closures(g: Grammar, names: Iterable[str] | None = None) -> dict[str, frozenset[str]]:
+    """Return :func:`rules_under` for every name of ``names`` (default: ``axiom`` and every rule).
+
+    The call graph is read once for all of them (asking :func:`rules_under` name by name
+    re-reads it each time: quadratic in the number of rules).
+    """
     uses = {r.name: {m.name for c in r.cases for m in c.body if isinstance(m, Symbol)} for r in g.rules}
-    todo = [m.name for m in g.axiom if isinstance(m, Symbol)] if name == "axiom" else [name]
-    seen: set[str] = set()
-    while todo:
-        n = todo.pop()
-        if n in uses and n not in seen:
-            seen.add(n)
-            todo.extend(uses[n])
-    return seen
+    start = [m.name for m in g.axiom if isinstance(m, Symbol)]
+    out: dict[str, frozenset[str]] = {}
+    for name in ("axiom", *uses) if names is None else names:
+        todo = list(start) if name == "axiom" else [name]
+        seen: set[str] = set()
+        while todo:
+            n = todo.pop()
+            if n in uses and n not in seen:
+                seen.add(n)
+                todo.extend(uses[n])
+        out[name] = frozenset(seen)
+    return out

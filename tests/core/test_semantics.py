@@ -108,9 +108,12 @@ def test_every_control_of_the_examples_sets_its_own_value(name):
 
 
 def test_rules_under_a_rule_are_itself_and_what_it_uses():
-    from lsys_core.grammar.semantics import rules_under
+    from lsys_core.grammar.semantics import rule_closures, rules_under
 
     g = parse_grammar((EXAMPLES / "facade.lsys").read_text(encoding="utf-8"))
     assert rules_under(g, "P2") == {"P2", "P1", "X1"}
     assert rules_under(g, "axiom") == {r.name for r in g.rules}
     assert rules_under(g, "X1") == {"X1"}
+    closures = rule_closures(g)
+    assert set(closures) == {"axiom", *(r.name for r in g.rules)}
+    assert all(closures[name] == rules_under(g, name) for name in closures)
