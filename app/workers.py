@@ -15,7 +15,9 @@ cancellation is forwarded to the process's own token, and a process that ignores
 Measured with ``tests/bench/bench_editor.py`` (2 cores): inference of a 1,200-element scene in
 a worker thread stalled the UI thread for 80–110 ms at worst; in a worker process, under 5 ms.
 Inference therefore runs in a process; derivation and rendering (numpy and skia, short GIL
-holds) in threads.
+holds) in threads, whose cancel tokens also share the GIL at every check
+(:class:`~lsys_core.cancel.CancelToken` ``share_gil``: many short numpy calls otherwise keep
+the UI thread out for tens of milliseconds).
 """
 
 from __future__ import annotations
@@ -212,7 +214,7 @@ class LatestRunner(QObject):
         self._pending = None
         if self._prepare is not None:
             request = self._prepare(request)
-        job = _Job(generation, request, CancelToken())
+        job = _Job(generation, request, CancelToken(share_gil=True))
         self._running = job
         with self._cv:
             self._handoff = job
