@@ -56,6 +56,7 @@ class _Card(QFrame):
         super().__init__(view._content)
         self.view = view
         self.card: Any = None
+        self._selected = False
         self.setObjectName("card")
         self.setFrameShape(QFrame.Shape.StyledPanel)
         self.fold = QToolButton(self)
@@ -124,7 +125,7 @@ class _Card(QFrame):
         self.card = card
         self.title.setText(self.title.text().split(" — ", 1)[0] + " — " + card.summary.split(": ", 1)[-1])
         for (line, _label, row), ctl in zip(self.lines, card.controls, strict=False):
-            if line.isVisible() and not row.slider.isSliderDown() and not row.spin.hasFocus():
+            if not line.isHidden() and not row.slider.isSliderDown() and not row.spin.hasFocus():
                 row.set_value(ctl.value)
 
     def _refresh(self) -> None:
@@ -159,6 +160,9 @@ class _Card(QFrame):
 
     def set_selected(self, selected: bool) -> None:
         """Frame the card when its rule is selected."""
+        if selected == self._selected:
+            return  # a style sheet change re-polishes the card and its children: only on change
+        self._selected = selected
         self.setStyleSheet("QFrame#card { border: 2px solid #f9a825; }" if selected else "")
 
     def mousePressEvent(self, event) -> None:
@@ -197,7 +201,7 @@ class RulesView(QWidget):
 
     def widget_of(self, owner: str) -> _Card | None:
         """Return the card widget of rule ``owner`` (None if it has none)."""
-        return next((w for w in self._widgets if w.isVisible() and w.card and w.card.owner == owner), None)
+        return next((w for w in self._widgets if not w.isHidden() and w.card and w.card.owner == owner), None)
 
     def control(self, owner: str, label: str) -> Any:
         """Return the current :class:`~lsys_core.grammar.semantics.Control` of a rule, or None."""
@@ -208,7 +212,7 @@ class RulesView(QWidget):
         """Show the cards of ``grammar`` (values only, if the rules and controls are the same)."""
         self.cards = {c.owner: c for c in cards}
         shape = [(c.owner, tuple(k.label for k in c.controls)) for c in cards]
-        visible = [w for w in self._widgets if w.isVisible()]
+        visible = [w for w in self._widgets if not w.isHidden()]
         if shape == self._shape:
             for widget, card in zip(visible, cards, strict=True):
                 widget.update_values(card)
@@ -237,7 +241,9 @@ class RulesView(QWidget):
         """Frame the card of rule ``owner`` and scroll to it (None: no selection)."""
         self._selected = owner
         for widget in self._widgets:
-            widget.set_selected(widget.card is not None and widget.card.owner == owner and widget.isVisible())
+            widget.set_selected(
+                widget.card is not None and widget.card.owner == owner and not widget.isHidden()
+            )
         widget = self.widget_of(owner) if owner else None
         if widget is not None:
             self._scroll.ensureWidgetVisible(widget, 0, 8)

@@ -99,3 +99,13 @@ def test_clean_numbers_is_one_step_or_a_message(window, tmp_path, wait_idle):
     assert "axiom: +(0) f(100) +(0) Q(3)" in doc.text and doc.undo_stack.count() == 1
     window.act_clean.trigger()
     assert doc.undo_stack.count() == 1 and "nothing changed" in messages[-1]
+
+
+def test_cards_follow_new_values_while_their_dock_is_closed(grid, wait_idle):
+    """A closed Rules view dock hides every card from Qt's point of view; the cards still follow."""
+    grid.cards_dock.hide()
+    grid.doc.edit_text(GRID.replace("f(20)", "f(25)"))
+    wait_idle(grid)  # an exception in a panel step would fail the test (pytest-qt)
+    assert grid.rules_view.cards["P"].summary == "row of 12, 25 apart"
+    grid.cards_dock.show()
+    assert "25 apart" in grid.rules_view.widget_of("P").title.text()
