@@ -99,3 +99,15 @@ def test_replace_from_the_palette_opens_replace_symbol_for_that_terminal(facade,
     ).setSelected(True)
     panel.replace_button.click()
     assert seen == [("terminal", "D"), True]
+
+
+def test_a_hidden_panel_catches_up_when_it_shows(facade, wait_idle):
+    panel = facade.structure_panel
+    facade.structure_dock.hide()
+    facade.doc.edit_text(facade.doc.text.replace("P2", "Q2"))
+    wait_idle(facade)
+    assert "Q2" in {r.name for r in facade.doc.grammar.rules}
+    assert "Q2" not in panel._items  # not rebuilt while nobody sees it
+    facade.structure_dock.show()
+    assert "Q2" in panel._items and "P2" not in panel._items
+    assert panel.tree.topLevelItem(0).text(2) == "72"
