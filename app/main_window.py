@@ -268,7 +268,7 @@ class MainWindow(WindowFiles, WindowEdits, QMainWindow):
         yield
         cards = core.describe(grammar)
         yield
-        self.rules_view.set_cards(grammar, cards)
+        yield from self.rules_view.card_steps(grammar, cards)
         yield
         self.structure_panel.set_content(grammar, cards, self.doc.drawing)
         yield

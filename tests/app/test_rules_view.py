@@ -109,3 +109,34 @@ def test_cards_follow_new_values_while_their_dock_is_closed(grid, wait_idle):
     assert grid.rules_view.cards["P"].summary == "row of 12, 25 apart"
     grid.cards_dock.show()
     assert "25 apart" in grid.rules_view.widget_of("P").title.text()
+
+
+def test_a_card_with_many_controls_opens_a_page_at_a_time(open_rules, wait_idle):
+    from app.params_panel import ROWS_PER_PAGE
+
+    calls = " ".join(f"[ +({i}) f({10 + i}) +(-{i}) P(2) ]" for i in range(1, 41))
+    window = open_rules(GRID.replace("axiom: +(45) f(100) +(-45) Q(3)", f"axiom: {calls}"))
+    card = window.rules_view.widget_of("axiom")
+    total = len(window.rules_view.cards["axiom"].controls)
+    assert total > ROWS_PER_PAGE
+    shown = [line for line, _, _ in card.lines if not line.isHidden()]
+    assert len(shown) == ROWS_PER_PAGE and not card.more.isHidden()
+    card.more.click()
+    shown = [line for line, _, _ in card.lines if not line.isHidden()]
+    assert len(shown) == min(total, 2 * ROWS_PER_PAGE)
+
+
+def test_the_editor_freezes_its_long_lived_heap(window, open_rules, wait_idle, qtbot):
+    import gc
+
+    from app.__main__ import FREEZE_AFTER_MS, settle_heap
+
+    try:
+        settle_heap(window)
+        first = gc.get_freeze_count()
+        assert first > 0
+        open_rules(GRID)
+        # the modules imported to derive and draw, FREEZE_AFTER_MS after the first drawing
+        qtbot.waitUntil(lambda: gc.get_freeze_count() > first, timeout=30 * FREEZE_AFTER_MS)
+    finally:
+        gc.unfreeze()
