@@ -15,10 +15,13 @@ import os
 import sys
 import traceback
 from collections.abc import Sequence
+from typing import Any
 
-__all__ = ["build_parser", "main"]
+__all__ = ["build_parser", "main", "settle_heap"]
 
 SCREENSHOT_TIMEOUT_S = 180
+#: The heap is frozen again this long after the first drawing (see :func:`settle_heap`).
+FREEZE_AFTER_MS = 1000
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -96,6 +99,26 @@ def _offer_recovery(window) -> None:
         discard_orphan(path)
 
 
+def settle_heap(window: Any) -> None:
+    """Freeze the heap now and once more a second after the window's first drawing.
+
+    See :func:`app.core.freeze_heap`: what exists when the window is built lives as long as
+    the process, and so do the modules first imported to open, derive and draw a document.
+    Only the editor's process does this (not every window: a test session opens hundreds).
+    """
+    from PySide6.QtCore import QTimer
+
+    from . import core
+
+    core.freeze_heap(collect=True)
+
+    def first_drawing(_drawing: Any) -> None:
+        window.doc.drawingChanged.disconnect(first_drawing)
+        QTimer.singleShot(FREEZE_AFTER_MS, window, core.freeze_heap)
+
+    window.doc.drawingChanged.connect(first_drawing)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the editor; return the process exit status."""
     import multiprocessing
@@ -128,6 +151,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 1
     screenshot = bool(args.screenshot)
     window = MainWindow(QSettings(), restore_layout=not screenshot, autosave=not screenshot)
+    settle_heap(window)
     _install_excepthook(window)
     if screenshot:
         window.resize(*_window_size(args.size))

@@ -21,6 +21,7 @@ __all__ = [
     "export_svg",
     "find_handles",
     "format_grammar",
+    "freeze_heap",
     "handle_values",
     "infer",
     "instance_centers",
@@ -150,6 +151,23 @@ def rules_under(grammar: Any, name: str) -> set[str]:
     from lsys_core.grammar.semantics import rules_under as _under
 
     return _under(grammar, name)
+
+
+def freeze_heap(*, collect: bool = False) -> None:
+    """Move every object now alive into the garbage collector's permanent generation.
+
+    The editor's modules, classes and widgets live as long as the process, and a full
+    collection traverses every tracked object: with them in the collected generations, each
+    full collection on the UI thread took 16–42 ms (50,000–87,000 objects) while rules with 833
+    parameters were applied.  Objects freed later by reference counting are still freed; only
+    reference cycles among frozen objects would stay, so this is called when the window is
+    built (after a collection) and once after the first drawing (modules imported on first use).
+    """
+    import gc
+
+    if collect:
+        gc.collect()
+    gc.freeze()
 
 
 def rule_closures(grammar: Any) -> dict[str, frozenset[str]]:

@@ -93,6 +93,9 @@ def make_window(**kwargs):
     win = MainWindow(settings, restore_layout=False, autosave=False, **kwargs)
     win.resize(1400, 900)
     win.show()
+    from app.__main__ import settle_heap
+
+    settle_heap(win)  # as the editor's main() does
     return win
 
 
