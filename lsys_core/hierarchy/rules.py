@@ -206,8 +206,8 @@ def build_hierarchy(
         t2 = time.perf_counter()
         chosen: list[Candidate] = []
         if cands and level < MAX_LEVELS:
-            first = nodes.first_members()
-            cands = [replace(c, start=_start(c, first)) for c in cands]
+            starts = _starts(cands, nodes.first_members())
+            cands = [replace(c, start=st) for c, st in zip(cands, starts, strict=True)]
             test = partial(
                 worthwhile,
                 ledger=ledger,
@@ -288,10 +288,22 @@ def _duplicates(table: SymbolTable, nodes: Nodes) -> list[Candidate]:
     ]
 
 
-def _start(c: Candidate, first: np.ndarray) -> tuple[float, float]:
-    """Mean input order of the first and of the second elements of a candidate's applications."""
-    second = [first[g[1]] if g.size > 1 else first[g[0]] for g in c.groups]
-    return float(np.mean([first[g[0]] for g in c.groups])), float(np.mean(second))
+def _starts(cands: list[Candidate], first: np.ndarray) -> list[tuple[float, float]]:
+    """Mean input order of the first and of the second elements of each candidate's applications.
+
+    One pass over all candidates' applications (a mean per candidate cost 4,224 numpy calls per
+    weight change on a 1,200-element scene: 40 ms); the orders are integers, so the sums are
+    exact and the means those of ``np.mean``.
+    """
+    counts = np.array([len(c.groups) for c in cands], np.int64)
+    total = int(counts.sum())
+    heads = np.fromiter((g[0] for c in cands for g in c.groups), np.int64, total)
+    seconds = np.fromiter((g[1] if g.size > 1 else g[0] for c in cands for g in c.groups), np.int64, total)
+    offsets = np.concatenate(([0], np.cumsum(counts)[:-1]))
+    order = np.asarray(first, np.float64)
+    head = np.add.reduceat(order[heads], offsets) / counts
+    second = np.add.reduceat(order[seconds], offsets) / counts
+    return list(zip(head.tolist(), second.tolist(), strict=True))
 
 
 def _apply_all(table: SymbolTable, book: _Book, chosen: list[Candidate], nodes: Nodes) -> Nodes:
