@@ -31,7 +31,7 @@ from . import core
 from .commands import SettingsCommand, TextCommand
 from .doc_files import DocumentFiles
 from .inference_control import INFER_PRELOAD, InferenceControl, Purpose
-from .jobs import InferOutcome, InferRequest
+from .jobs import InferOutcome, InferRequest, scene_digest
 from .rules_model import RulesModel
 
 __all__ = ["INFER_PRELOAD", "Document"]
@@ -76,6 +76,7 @@ class Document(DocumentFiles, QObject):
         super().__init__(parent)
         self.undo_stack = QUndoStack(self)
         self.scene: Any = None
+        self._scene_key: tuple[Any, bytes] = (None, b"")  # (scene, its digest)
         self.scene_path: str | None = None
         self.path: str | None = None
         self.result: Any = None
@@ -256,7 +257,7 @@ class Document(DocumentFiles, QObject):
             self.apply_settings(settings)
             return
         self.pending_settings = settings
-        request = InferRequest(self.scene, settings, self.randomize)
+        request = InferRequest(self.scene, settings, self.randomize, scene_key=self.scene_key())
         purpose = Purpose("settings", settings=settings, merge_key=self.merge_key("settings"))
         self.inference.submit(purpose, request, immediate=False)
 
@@ -307,7 +308,20 @@ class Document(DocumentFiles, QObject):
     def reinfer(self) -> None:
         """Run inference again with the current settings (one undo step if the rules change)."""
         if self.can_infer:
-            self.inference.submit(Purpose("reinfer"), InferRequest(self.scene, self.settings, self.randomize))
+            request = InferRequest(self.scene, self.settings, self.randomize, scene_key=self.scene_key())
+            self.inference.submit(Purpose("reinfer"), request)
+
+    def scene_key(self) -> bytes | None:
+        """Return the digest of the input scene (computed once per scene; None: no scene).
+
+        Weight changes send it with the scene, so the worker finds its kept analysis without
+        digesting the scene again.
+        """
+        if self.scene is None:
+            return None
+        if self._scene_key[0] is not self.scene:
+            self._scene_key = (self.scene, scene_digest(self.scene))
+        return self._scene_key[1]
 
     def cancel_inference(self) -> None:
         """Cancel the running inference; the document keeps its rules and their settings."""

@@ -55,6 +55,7 @@ class InferRequest:
     svg_path: str | None = None
     limit: int = DERIVE_LIMIT
     load_only: bool = False  # only load ``svg_path`` (restoring a session), no inference
+    scene_key: bytes | None = None  # scene_digest(scene) when the requester knows it
 
 
 @dataclass(frozen=True)
@@ -91,13 +92,16 @@ def scene_digest(scene: Any) -> bytes:
     return hashlib.blake2b(pickle.dumps(scene, protocol=pickle.HIGHEST_PROTOCOL), digest_size=20).digest()
 
 
-def infer_kept(scene: Any, settings: Any, cancel: CancelToken, progress: Progress) -> Any:
+def infer_kept(
+    scene: Any, settings: Any, cancel: CancelToken, progress: Progress, key: bytes | None = None
+) -> Any:
     """Infer ``scene`` with ``settings``, reusing the analysis kept from the same scene.
 
     Only what the settings change is computed again (:func:`lsys_core.pipeline.analyse` with
-    ``previous``); the result is what :func:`lsys_core.pipeline.infer` gives.
+    ``previous``); the result is what :func:`lsys_core.pipeline.infer` gives.  ``key`` is the
+    scene's digest if the requester knows it (digesting 1,200 elements takes 11 ms).
     """
-    key = scene_digest(scene)
+    key = key or scene_digest(scene)
     previous = _KEPT[0][1] if _KEPT and _KEPT[0][0] == key else None
     if previous is not None:
         scene = previous.scene  # the very object the kept analysis holds
@@ -116,7 +120,7 @@ def run_inference(request: InferRequest, cancel: CancelToken, progress: Progress
     if request.symmetrize:
         result = core.symmetrize(scene, request.settings, cancel=cancel, progress=progress)
     else:
-        result = infer_kept(scene, request.settings, cancel, progress)
+        result = infer_kept(scene, request.settings, cancel, progress, request.scene_key)
     grammar = replace(result.grammar, randomize=request.randomize)
     text = core.format_grammar(grammar)
     try:

@@ -57,3 +57,24 @@ def test_a_new_scene_or_similarity_threshold_analyses_again(counted):
     _infer(load_svg(str(EXAMPLES / "facade.svg")), stricter)
     assert len(counted) == 3
     assert jobs.scene_digest(load_svg(str(EXAMPLES / "facade.svg"))) == jobs._KEPT[0][0]
+
+
+def test_a_request_that_names_its_scene_is_not_digested_again(counted, monkeypatch):
+    scene = load_svg(str(EXAMPLES / "flower-ring.svg"))
+    key = jobs.scene_digest(scene)
+    digests = []
+    real = jobs.scene_digest
+    monkeypatch.setattr(jobs, "scene_digest", lambda s: digests.append(1) or real(s))
+    settings = pipeline.InferenceSettings()
+    for wh in (1.0, 0.5):
+        request = jobs.InferRequest(scene, replace(settings, wh=wh), scene_key=key)
+        jobs.run_inference(request, CancelToken(), lambda stage, fraction: None)
+    assert digests == [] and len(counted) == 1 and jobs._KEPT[0][0] == key
+
+
+def test_the_document_digests_its_scene_once(window, wait_idle):
+    window.open_path(str(EXAMPLES / "flower-ring.svg"))
+    wait_idle(window)
+    doc = window.doc
+    key = doc.scene_key()
+    assert key == jobs.scene_digest(doc.scene) and doc.scene_key() is key
