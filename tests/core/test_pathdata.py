@@ -216,3 +216,24 @@ def test_table_rows_are_absolute():
     table = parse_path("m1 1 h2 v2 z")
     assert table.error is None
     assert table.pts[:, 3].tolist() == [1 + 1j, 3 + 1j, 3 + 3j, 1 + 1j]
+
+
+_TOKENS = st.sampled_from(
+    ["1", "12", "-3", "+4", ".5", "1.", "1.5", "1e3", "1E-2", "2e+1", "e", ".", "-", "1.5.5", "x"]
+)
+_SEPS = st.sampled_from(["", " ", ",", " , ", "\t", "\n"])
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.lists(st.tuples(st.one_of(_TOKENS, _COMMAND), _SEPS), max_size=20), st.booleans())
+def test_the_short_path_lexes_like_the_vectorised_one(tokens, letters):
+    import lsys_core.geometry.numbers as numbers
+
+    text = "".join(t + s for t, s in tokens)
+    quick = numbers._lex_short(text.encode(), letters)
+    whole = numbers._lex_chunk(np.frombuffer(text.encode(), np.uint8), letters)
+    if quick is None:  # not well-formed: the vectorised lexer reports an error
+        assert whole[4].size > 0
+        return
+    for got, want in zip(quick, whole, strict=True):
+        assert np.array_equal(got, want), text
