@@ -29,6 +29,27 @@ def rotating_grid_svg(rows: int, cols: int, step: float = 40.0, turn: float = 12
     )
 
 
+def scattered_svg(n: int, seed: int = 7, size: float = 1000.0, turn: bool = False) -> str:
+    """``n`` copies of one triangle at random places (and at random angles if ``turn``)."""
+    import random
+
+    rng = random.Random(seed)
+    parts = []
+    for _ in range(n):
+        x, y = rng.uniform(0, size), rng.uniform(0, size)
+        a = math.radians(rng.uniform(0, 360)) if turn else 0.0
+        ca, sa = math.cos(a), math.sin(a)
+        pts = " ".join(
+            f"{x + ca * u - sa * v:.4f},{y + sa * u + ca * v:.4f}" for u, v in ((0, 0), (10, 0), (7, 13))
+        )
+        parts.append(f'<polygon fill="#3949ab" points="{pts}"/>')
+    return (
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{size}" viewBox="0 0 {size} {size}">\n'
+        + "\n".join(parts)
+        + "\n</svg>\n"
+    )
+
+
 def grid_dims(n: int) -> tuple[int, int]:
     """Rows and columns of a roughly 3:4 grid with about ``n`` elements (1200 -> 30 x 40)."""
     rows = max(1, round(math.sqrt(n * 3 / 4)))
