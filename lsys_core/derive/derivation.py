@@ -98,6 +98,25 @@ class _Emitter:
             )
         )
 
+    def add_many(self, term, paint, slot, rule: int, a, b, z, m, parent, rank) -> None:
+        """Like :meth:`add` for instances of several draw ops (per-instance term, paint, slot)."""
+        n = a.size
+        self.count += n
+        self.parts.append(
+            (
+                term.astype(np.int32),
+                a,
+                b,
+                z,
+                np.full(n, rule, np.int32),
+                m,
+                slot,
+                paint.astype(np.int32),
+                parent,
+                rank,
+            )
+        )
+
 
 def derive(
     grammar: Grammar,
@@ -200,12 +219,45 @@ class _Derivation:
                 )
             self.emitter.add(op, rule, a, b, z, m, parent, rank)
 
+    def emit_all(self, draws, rule: int, where: str, m, parent) -> None:
+        """Record the draws of one body run at once (each ranked by its op index in the body).
+
+        The same instances as :meth:`emit` draw by draw, in the same order, with one check and
+        one batch: a body placing 3,000 elements one by one made 3,000 batches of a dozen
+        numpy calls each.
+        """
+        if len(draws) <= 1:
+            for i, op, a, b, z in draws:
+                self.emit([(i, op, a, b, z)], rule, where, m, parent, i)
+            return
+        n = m.size
+        a = np.concatenate([d[2] for d in draws])
+        b = np.concatenate([d[3] for d in draws])
+        z = np.concatenate([d[4] for d in draws])
+        self.emitter.reserve(a.size, where)
+        if not (np.isfinite(a).all() and np.isfinite(b).all()):
+            raise LimitError(
+                f"derivation overflows in {where}: its scales or distances grow beyond floating-point range"
+            )
+        ops = np.array([d[1][1:] for d in draws], np.int64).reshape(len(draws), 3)  # term, paint, slot
+        self.emitter.add_many(
+            np.repeat(ops[:, 0], n),
+            np.repeat(ops[:, 1], n),
+            np.repeat(ops[:, 2], n),
+            rule,
+            a,
+            b,
+            z,
+            np.tile(np.broadcast_to(np.asarray(m, np.int64), (n,)), len(draws)),
+            np.tile(np.broadcast_to(np.asarray(parent, np.int64), (n,)), len(draws)),
+            np.repeat(np.array([d[0] for d in draws], np.int64), n),
+        )
+
     def run(self) -> tuple[Drawing, Trace]:
         one = np.zeros(1, np.int64)
         root = np.zeros(1, np.int64)
         _, _, _, draws, calls = self.interp.run(self.program.axiom, one, perturb=False)
-        for i, op, a, b, z in draws:
-            self.emit([(i, op, a, b, z)], -1, "the axiom", one, root, i)
+        self.emit_all(draws, -1, "the axiom", one, root)
         for i, target, m, a, b, z in calls:
             self.push(target, m, a, b, z, root, i)
         while self.queue:
@@ -234,8 +286,7 @@ class _Derivation:
             ms, as_, bs, zs, ids_ = m[sel], a[sel], b[sel], z[sel], ids[sel]
             if case.tail is None:
                 _, _, _, draws, calls = self.interp.run(case.ops, ms, as_, bs, zs)
-                for i, op, da, db, dz in draws:
-                    self.emit([(i, op, da, db, dz)], r, where, ms, ids_, i)
+                self.emit_all(draws, r, where, ms, ids_)
                 for i, target, mm, ca, cb, cz in calls:
                     self.push(target, mm, ca, cb, cz, ids_, i)
             else:
