@@ -1,6 +1,7 @@
 """Compile a grammar's bodies into flat op lists for the vectorised derivation.
 
-Ops: ``("t", op, c0, cd)`` turtle command (``f + - * z``), ``("[",)`` push, ``("]",)`` pop,
+Ops: ``("t", op, c0, cd, table)`` turtle command (``f + - * z``; ``table`` the value's table, empty
+or None when it is linear), ``("[",)`` push, ``("]",)`` pop,
 ``("draw", terminal, paint, slot)`` a terminal occurrence (``paint`` indexes the compiled
 paints, -1 for none; ``slot`` numbers every terminal occurrence of the grammar), and
 ``("call", rule, k0, k1)`` a non-terminal with counter ``k0 + k1·m``.
@@ -52,7 +53,10 @@ def compile_grammar(grammar: Grammar) -> Program:
         ops: list[Op] = []
         for i, mod in enumerate(body):
             if isinstance(mod, Turtle):
-                ops.append(("t", mod.op, float(mod.value.c0), 0.0 if axiom else float(mod.value.cd)))
+                v = mod.value
+                ops.append(
+                    ("t", mod.op, float(v.c0), 0.0 if axiom else float(v.cd), None if axiom else v.table)
+                )
             elif isinstance(mod, Push):
                 ops.append(("[",))
             elif isinstance(mod, Pop):

@@ -99,7 +99,7 @@ def _step(g: Grammar, card: Card) -> tuple[complex, complex] | None:
     for mod in reversed(body[:-1]):  # the run of turtle moves just before the tail call
         if not isinstance(mod, Turtle):
             break
-        if mod.value.cd:
+        if mod.value.cd or mod.value.table:
             return None
         run.append(mod)
     a, b = 1 + 0j, 0j

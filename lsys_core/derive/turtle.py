@@ -59,8 +59,11 @@ class Interpreter:
         for i, op in enumerate(ops):
             kind = op[0]
             if kind == "t":
-                _, sym, c0, cd = op
-                v = c0 + cd * m if cd else np.full(n, c0)
+                _, sym, c0, cd, table = op
+                if table:
+                    v = np.asarray(table, float)[m % len(table)]
+                else:
+                    v = c0 + cd * m if cd else np.full(n, c0)
                 if sym == "f":
                     if rand is not None and rand.distance:
                         v = v * (1.0 + self.rng.uniform(-rand.distance, rand.distance, n))
@@ -103,8 +106,8 @@ def _run_one(ops, m: int, a: complex, b: complex, z: float):
     for i, op in enumerate(ops):
         kind = op[0]
         if kind == "t":
-            _, sym, c0, cd = op
-            v = c0 + cd * m
+            _, sym, c0, cd, table = op
+            v = table[m % len(table)] if table else c0 + cd * m
             if sym == "f":
                 b = b + a * v
             elif sym == "*":

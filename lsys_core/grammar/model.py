@@ -24,6 +24,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Final, Literal
 
+import numpy as np
+
 __all__ = [
     "COND_EQ0",
     "COND_GT0",
@@ -61,10 +63,30 @@ PAINT_PROPS = ("opacity", "fill-opacity", "stroke-opacity", "stroke-width", "hue
 
 @dataclass(frozen=True)
 class Linear:
-    """A value linear in the counter: ``c0 + cd * m``."""
+    """A value linear in the counter, ``c0 + cd * m``, or a table of values indexed by it.
+
+    With a non-empty ``table`` (written ``[v0, v1, ...]``) the value at counter ``m`` is
+    ``table[m mod len(table)]``: a sequence whose steps repeat one shape and one move while
+    one number varies freely (the radii of concentric circles, the data offsets of a dot plot)
+    or cycles (alternating sizes).  Tables stand in turtle values of rules with a counter;
+    ``c0`` is then ``table[0]`` and ``cd`` 0, so code that reads only ``c0`` sees a value.
+    """
 
     c0: float
     cd: float = 0.0
+    table: tuple[float, ...] = ()
+
+    @classmethod
+    def of_table(cls, values) -> Linear:
+        """Return the table value of ``values`` (at least one)."""
+        table = tuple(float(v) for v in values)
+        return cls(table[0], 0.0, table)
+
+    def at(self, m):
+        """Return the value at counter(s) ``m`` (an int or an integer numpy array)."""
+        if self.table:
+            return np.asarray(self.table)[np.asarray(m) % len(self.table)]
+        return self.c0 + self.cd * m
 
 
 @dataclass(frozen=True)

@@ -12,7 +12,8 @@ case
 index
     0-based module index in the body (brackets and symbols count too);
 field
-    ``v`` (``t0``), ``dv`` (``tΔ``) or ``m`` (a constant counter argument).
+    ``v`` (``t0``), ``dv`` (``tΔ``), ``m`` (a constant counter argument) or, for a table value
+    ``[v0, v1, ...]``, ``tJ`` (its entry ``J``; ``v`` names entry 0).
 
 ``P.0.1.v`` is the ``f(24)`` of ``P(m): m > 0 -> A f(24) ...``.  The key ``m`` is an alias
 of the first constant counter argument of the axiom (the derivation depth).
@@ -92,6 +93,12 @@ def list_params(g: Grammar) -> list[Param]:
                 nth[mod.op] += 1
                 label = f"{prefix}: {mod.op} #{nth[mod.op]}"
                 kind = _KIND_OF_OP[mod.op]
+                if mod.value.table:
+                    out += [
+                        Param(f"{key}.t{j}", f"{label} [{j}]", float(x), kind)
+                        for j, x in enumerate(mod.value.table)
+                    ]
+                    continue
                 out.append(Param(f"{key}.v", label, float(mod.value.c0), kind))
                 if mod.value.cd != 0:
                     out.append(Param(f"{key}.dv", f"{label} Δ", float(mod.value.cd), f"{kind}_delta"))
@@ -137,6 +144,14 @@ def set_param(g: Grammar, key: str, value: float) -> Grammar:
         if not x.is_integer() or not 0 <= x <= COUNT_LIMIT:
             raise GrammarError(f"parameter {key}: a count must be a whole number >= 0, got {value!r}")
         new: Module = replace(mod, arg=replace(mod.arg, k0=int(x)))
+    elif isinstance(mod, Turtle) and mod.value.table:
+        if mod.op == "*" and x <= 0:
+            raise GrammarError(f"parameter {key}: a scale must be positive, got {value!r}")
+        if fld == "dv":
+            raise GrammarError(f"parameter {key}: a table value [...] has no Δ; set its entries t0, t1, ...")
+        j = 0 if fld == "v" else int(fld[1:])
+        table = mod.value.table
+        new = replace(mod, value=Linear.of_table((*table[:j], x, *table[j + 1 :])))
     elif isinstance(mod, Turtle):
         lin = Linear(x, mod.value.cd) if fld == "v" else Linear(mod.value.c0, x)
         if mod.op == "*" and lin.cd == 0 and lin.c0 <= 0:
@@ -182,6 +197,11 @@ def _finite(key: str, value: float | str) -> float:
     return x
 
 
+def _table_entry(fld: str, size: int) -> bool:
+    """Tell whether ``fld`` is ``tJ``, an entry of a table of ``size`` values."""
+    return fld.startswith("t") and fld[1:].isdigit() and int(fld[1:]) < size
+
+
 def _resolve(g: Grammar, key: str) -> tuple[str, int, int, str]:
     """Return ``(owner, case, index, field)`` of a parameter key, checked against ``g``."""
     if key == "m":
@@ -198,6 +218,8 @@ def _resolve(g: Grammar, key: str) -> tuple[str, int, int, str]:
         if isinstance(target, Turtle) and (
             fld == "v" or (fld == "dv" and rule is not None and rule.parametric)
         ):
+            return owner, ci, index, fld
+        if isinstance(target, Turtle) and _table_entry(fld, len(target.value.table)):
             return owner, ci, index, fld
         if isinstance(target, Symbol) and fld == "m" and target.arg is not None and target.arg.k1 == 0:
             return owner, ci, index, fld

@@ -44,6 +44,8 @@ class LineReader:
         self.reserved = reserved
         self.places = places
         self.turtle_ops = turtle_ops
+        #: Whether the file's version has table values ``[v0, v1, ...]`` (version 3).
+        self.tables = True
 
     def peek(self) -> Tok:
         """Return the current token without consuming it."""
@@ -128,7 +130,8 @@ class LineReader:
                 self.take()
                 self.expect("(", f"'(' after '{tok.text}'")
                 self.places[(where, owner, ci, len(mods), True)] = self.peek().pos
-                mods.append(Turtle(_TURTLE_OPS[tok.text], self.linear(no_m)))
+                value = self.table(no_m) if self.at("[") else self.linear(no_m)
+                mods.append(Turtle(_TURTLE_OPS[tok.text], value))
                 self.expect(")")
             elif tok.kind == "name" and tok.text == "m":
                 raise fail("m is the counter: use it in an argument, e.g. P(m-1) or f(2*m)", tok)
@@ -238,6 +241,20 @@ class LineReader:
         if not (abs(c0) < float("inf") and abs(cd) < float("inf")):
             raise fail("value out of range (not a finite number)", start)
         return Linear(c0, cd)
+
+    def table(self, no_m: str | None) -> Linear:
+        """Read a table value ``[v0, v1, ...]`` (signed numbers, at least one)."""
+        start = self.take()
+        if not self.tables:
+            raise fail("a table value [...] needs format version 3: write 'lsys 3' as the header", start)
+        if no_m is not None:
+            raise fail(no_m.replace("m cannot", "a table [...] indexed by m cannot"), start)
+        values = [self.signed_number()]
+        while self.at(","):
+            self.take()
+            values.append(self.signed_number())
+        self.expect("]", "',' or ']' in the table")
+        return Linear.of_table(values)
 
     def count(self, no_m: str | None) -> Count:
         """Read an integer counter argument ``k0 + k1*m``."""

@@ -85,7 +85,7 @@ def runs(owner: str, ci: int, body: tuple[Module, ...]) -> Iterator[tuple[int, l
     for i, mod in enumerate(body):
         if isinstance(mod, Turtle) and mod.op == "z":
             continue  # paint order moves no geometry: the run goes on
-        if isinstance(mod, Turtle):
+        if isinstance(mod, Turtle) and not mod.value.table:  # a table value ends a run, as a symbol does
             run.append(Op(f"{owner}.{ci}.{i}.v", mod.op, float(mod.value.c0), float(mod.value.cd)))
             continue
         if run:

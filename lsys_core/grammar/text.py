@@ -92,6 +92,7 @@ class _Line(LineReader):
         v1 = state.version == 1
         super().__init__(toks, RESERVED_V1 if v1 else RESERVED, state.places, "f" if v1 else "fz")
         self.st = state
+        self.tables = state.version >= 3
         self.keywords = KEYWORDS_V1 if v1 else KEYWORDS
 
     def header(self) -> None:
@@ -103,12 +104,13 @@ class _Line(LineReader):
         tok = self.peek()
         if tok.kind != "num":
             raise fail(f"expected a format version after 'lsys', got {tok.shown()}", tok)
-        if tok.text not in ("1", str(FORMAT_VERSION)):
+        if tok.text not in tuple(str(v) for v in range(1, FORMAT_VERSION + 1)):
             raise fail(
                 f"unsupported format version {tok.text}: this program reads versions 1 to {FORMAT_VERSION}",
                 tok,
             )
         self.st.version = int(self.take().text)
+        self.tables = self.st.version >= 3
         self.end()
 
     def statement(self) -> None:

@@ -272,6 +272,8 @@ def _paint_problem(names: _Names, paint: Paint, parametric: bool, no_m: str) -> 
         seen.add(key)
         if not isinstance(v, Linear) or not (_finite(v.c0) and _finite(v.cd)):
             return f"the value of '{key}' must be a finite number"
+        if v.table:
+            return f"paint property '{key}' takes a number or a value linear in m, not a table [...]"
         if v.cd != 0 and not parametric:
             return no_m
     return None
@@ -340,8 +342,12 @@ def _turtle_problem(mod: Turtle, parametric: bool, no_m: str) -> str | None:
     v = mod.value
     if not isinstance(v, Linear) or not (_finite(v.c0) and _finite(v.cd)):
         return f"the value of {mod.op}(...) must be a finite number"
-    if v.cd != 0 and not parametric:
+    if v.table and not all(_finite(x) for x in v.table):
+        return f"the values of {mod.op}([...]) must be finite numbers"
+    if (v.cd != 0 or v.table) and not parametric:
         return no_m
+    if mod.op == "*" and v.table and min(v.table) <= 0:
+        return "scale must be positive: a table of *([...]) holds 0 or a negative scale"
     if mod.op == "*" and v.cd == 0 and v.c0 <= 0:
         return "scale must be positive: *(0) or a negative *(s) collapses or flips the drawing"
     return None

@@ -8,8 +8,8 @@ from lsys_core.grammar.validate import count_text
 
 __all__ = ["FORMAT_VERSION", "format_grammar", "format_number", "format_version"]
 
-FORMAT_VERSION = 2
-"""The newest format version (version 1 is read too).  A grammar is written in the oldest
+FORMAT_VERSION = 3
+"""The newest format version (versions 1 and 2 are read too).  A grammar is written in the oldest
 version that expresses it: see :func:`format_version`."""
 
 #: Table items per line of a ``paint:`` or ``order:`` statement (a continued statement repeats its keyword).
@@ -77,9 +77,12 @@ def format_version(g: Grammar) -> int:
     (:attr:`~lsys_core.grammar.model.Terminal.scaled`, version 1's meaning) and that uses nothing
     version 2 added: named styles, occurrence paints, ``z``, the ``paint:``/``order:`` tables,
     ``defs``, ``verbatim`` content and the ``randomize`` line.  So a version-1 file stays
-    readable by version-1 readers after it is edited and saved.
+    readable by version-1 readers after it is edited and saved.  Version 3 added table values
+    ``[v0, v1, ...]``; a grammar without them is written in version 2 or 1.
     """
     bodies = [g.axiom] + [c.body for r in g.rules for c in r.cases]
+    if any(isinstance(m, Turtle) and m.value.table for body in bodies for m in body):
+        return 3
     v2 = (
         g.randomize is not None
         or bool(g.styles or g.paint or g.order or g.defs or g.verbatim)
@@ -180,7 +183,9 @@ def format_number(x: float) -> str:
 
 
 def _linear(v: Linear) -> str:
-    """Return ``c0``, ``c0 + cd*m``, ``c0 - cd*m`` or ``cd*m``."""
+    """Return ``c0``, ``c0 + cd*m``, ``c0 - cd*m``, ``cd*m`` or a table ``[v0, v1, ...]``."""
+    if v.table:
+        return "[" + ", ".join(format_number(x) for x in v.table) + "]"
     if v.cd == 0:
         return format_number(v.c0)
     mag = abs(float(v.cd))

@@ -36,6 +36,8 @@ def _turtle_bits(prec: Precision, t: Turtle) -> float:
             return prec.length_bits
         return prec.scale_bits() if t.op == "*" else angle_value_bits(prec, v)
 
+    if t.value.table:  # its length, then every entry
+        return OP_BITS + float(count_bits(len(t.value.table))) + sum(number(v) for v in t.value.table)
     return (
         OP_BITS
         + (number(t.value.c0) if t.value.c0 != 0 else 0.0)
@@ -55,7 +57,7 @@ def compose(turtles: list[Turtle]) -> tuple[complex, complex] | None:
     """The relative frame ``(A, B)`` of constant turtle commands (None if one depends on ``m``)."""
     a, b = 1 + 0j, 0j
     for t in turtles:
-        if t.value.cd != 0:
+        if t.value.cd != 0 or t.value.table:
             return None
         v = t.value.c0
         if t.op == "f":
