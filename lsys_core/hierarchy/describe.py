@@ -23,6 +23,7 @@ from lsys_core.hierarchy.mdl import (
     placement_set_bits,
     pose_bits,
     shape_bits,
+    table_bits,
     token_bits,
     transform_bits,
 )
@@ -36,8 +37,8 @@ def _turtle_bits(prec: Precision, t: Turtle) -> float:
             return prec.length_bits
         return prec.scale_bits() if t.op == "*" else angle_value_bits(prec, v)
 
-    if t.value.table:  # its length, then every entry
-        return OP_BITS + float(count_bits(len(t.value.table))) + sum(number(v) for v in t.value.table)
+    if t.value.table:
+        return OP_BITS + table_bits(prec, t.value.table, t.op)
     return (
         OP_BITS
         + (number(t.value.c0) if t.value.c0 != 0 else 0.0)

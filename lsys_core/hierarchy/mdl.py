@@ -45,6 +45,7 @@ __all__ = [
     "placement_set_bits",
     "pose_bits",
     "shape_bits",
+    "table_bits",
     "token_bits",
     "transform_bits",
 ]
@@ -229,6 +230,26 @@ def angle_value_bits(prec: Precision, degrees: float) -> float:
         if j != 0 and abs(degrees - 360.0 * j / k) <= tol:
             return min(full, 2.0 * math.log2(k) + 1.0 + math.log2(abs(j) + 1.0))
     return full
+
+
+def table_bits(prec: Precision, values, op: str, lever: float | None = None) -> float:
+    """Bits of a table value ``[v0, v1, …]`` of turtle command ``op``: its length, its smallest
+    entry at full precision, then every entry within the table's range.
+
+    Distances are measured in document units, scales as ``ln s`` times ``lever`` (the radius of
+    the shape they scale, default the diagonal) and angles as turns of the diagonal, so each
+    entry costs ``log2(range / eps + 1)``: a table of nearly equal values is cheap.
+    """
+    v = np.asarray(values, dtype=float)
+    reach = prec.diagonal if lever is None else float(lever)
+    if op == "*":
+        v, first = np.log(np.maximum(v, 1e-300)) * reach, prec.scale_bits(reach)
+    elif op == "f":
+        first = prec.length_bits
+    else:
+        v, first = np.radians(v) * prec.diagonal, prec.angle_bits()
+    spread = float(np.ptp(v)) if v.size else 0.0
+    return float(count_bits(v.size)) + first + v.size * math.log2(spread / prec.eps + 1.0)
 
 
 def transform_bits(prec: Precision, A: complex, B: complex) -> float:

@@ -35,6 +35,7 @@ from lsys_core.hierarchy.select import Measure, Weights, choose, worthwhile
 from lsys_core.hierarchy.snap import SHARE
 from lsys_core.hierarchy.spaces import pair_space
 from lsys_core.hierarchy.symbols import SymbolTable
+from lsys_core.hierarchy.tabulated import find_tabulated, shortens, tabulated_rule
 
 __all__ = ["Hierarchy", "Tolerance", "Weights", "build_hierarchy"]
 
@@ -228,6 +229,10 @@ def build_hierarchy(
         clock["rules"] += time.perf_counter() - t2
         if not chosen:
             break
+    if len(nodes) > 1:
+        period = np.concatenate([term_period, np.zeros(len(table) - nt)])
+        nodes, tabulated = _tabulate(table, book, nodes, period, prec)
+        level += tabulated
     axiom = _axiom(table, book, nodes)
     report(progress, "rules", 1.0)
     return Hierarchy(tuple(book.rules), axiom, level, tuple(book.log), closed=len(nodes) == 1)
@@ -263,6 +268,28 @@ def _axiom(table: SymbolTable, book: _Book, nodes: Nodes) -> tuple[Module, ...]:
         Rule(name, False, (Case(None, tuple(body)),)), f"{name}: places the {len(nodes)} remaining nodes"
     )
     return (*const_t(a0, b0), Symbol(name))
+
+
+def _tabulate(
+    table: SymbolTable, book: _Book, nodes: Nodes, period: np.ndarray, prec: Precision
+) -> tuple[Nodes, int]:
+    """Code the partly regular repetitions left (:mod:`.tabulated`) that shorten the description."""
+    groups: list[np.ndarray] = []
+    syms: list[int] = []
+    for t in find_tabulated(table, nodes, period):
+        if not shortens(prec, table, t, tabulated_rule(table, t, "T", nodes), nodes):
+            continue
+        name = table.new_name("P")
+        what = "concentric copies" if t.kind == "scale" else "a row with offsets"
+        book.add(tabulated_rule(table, t, name, nodes), f"{name}: {what} of {t.nodes.size} nodes (table)")
+        groups.append(t.nodes)
+        syms.append(table.symbol(name, t.steps - 1))
+    if not groups:
+        return nodes, 0
+    nodes, _ = nodes.merge(groups, syms)
+    for sid, i in zip(syms, range(len(nodes) - len(groups), len(nodes)), strict=True):
+        table.set_size(sid, float(nodes.radius[i] / abs(nodes.a[i])))
+    return nodes, 1
 
 
 def _duplicates(table: SymbolTable, nodes: Nodes) -> list[Candidate]:

@@ -1,0 +1,286 @@
+"""Partly regular repetitions: one shape and one step repeated while one number varies freely.
+
+The paper's sequences (§5.5) repeat one transformation exactly, so every number of the step is
+the same from copy to copy.  Real drawings often repeat a shape in a pattern that is regular in
+all but one number:
+
+* *concentric copies*: one shape drawn several times about one centre, at sizes that follow no
+  progression (the rings of a wheel, a target), coded ``P(m) -> [ *([s…]) A ] P(m-1)``;
+* *rows at data positions*: copies evenly spaced along an axis (rows of a dot plot, bars of a
+  chart) but each moved across it by its own amount, coded
+  ``P(m) -> [ +(φ) f([o…]) +(-φ) A ] +(ψ) f(d) +(-ψ) P(m-1)``.
+
+The free number is written as a table value (``[v0, v1, …]``, entry ``m``), the rest as one
+rule.  These are looked for among the nodes that no exact repetition explained, just before the
+last rule places the rest one by one.  A row is written only when it shortens the description
+(:mod:`lsys_core.hierarchy.mdl`): its table entries cost ``log2(range/eps + 1)`` bits each, while
+placing the copies one by one costs what they add to the set of all placements of their shape;
+rows of a handful of copies, or copies spread over the drawing, stay placed one by one.
+Concentric copies cost as many bits either way and are written as a rule (see :data:`RULE_BITS`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from lsys_core.grammar.model import Case, Count, Linear, Module, Pop, Push, Rule, Symbol, Turtle
+from lsys_core.hierarchy.describe import rule_bits
+from lsys_core.hierarchy.emit import const_t, nice_array
+from lsys_core.hierarchy.mdl import (
+    KIND_BITS,
+    Precision,
+    angle_value_bits,
+    count_bits,
+    placement_set_bits,
+    pose_bits,
+    table_bits,
+    token_bits,
+    transform_bits,
+)
+from lsys_core.hierarchy.nodes import Nodes
+from lsys_core.hierarchy.symbols import SymbolTable
+
+__all__ = ["Tabulated", "find_tabulated", "shortens", "tabulated_rule"]
+
+#: Fewest copies a partly regular repetition must have.
+MIN_COPIES = 3
+#: Concentric copies are coded by the set code of placements (:mod:`.mdl`) as copies stacked at
+#: one place, with one scale each: the same numbers the rule writes.  The rule is written when it
+#: is longer by at most this much, its fixed cost (kind, name, count, brackets, call), since it
+#: then states in the rules what the set code says implicitly.  (Copies at random places never
+#: share a centre, so this cannot turn chance into rules.)
+RULE_BITS = 32.0
+#: Axes rows are looked for along: the canvas's (charts and designers' grids are aligned to them).
+AXES = (1 + 0j, 1j)
+
+
+@dataclass(frozen=True)
+class Tabulated:
+    """One partly regular repetition of symbol ``sym``.
+
+    Attributes
+    ----------
+    nodes : ndarray of int
+        The nodes it covers, in the order it draws them (its first node first).
+    kind : str
+        ``"scale"`` (concentric copies, the scale varies) or ``"offset"`` (a row along ``axis``
+        whose copies move across it).
+    axis : complex
+        Unit direction of the row in document coordinates (1 for concentric copies).
+    step : float
+        Distance between consecutive copies along the axis (0 for concentric copies).
+    values : ndarray of float
+        The free number of every copy, one row per step of the rule in drawing order: its
+        scale relative to the first copy (one column), or its offset across the axis from the
+        first copy (document units; one column per copy at each level of the row).
+    """
+
+    sym: int
+    nodes: np.ndarray
+    kind: str
+    axis: complex
+    step: float
+    values: np.ndarray
+
+    @property
+    def steps(self) -> int:
+        """Applications of the rule's step: the levels of a row, the copies of a concentric set."""
+        return int(self.values.shape[0])
+
+
+def _turn_error(a: np.ndarray, a0: complex, lever: np.ndarray, period: float) -> np.ndarray:
+    """How far turning from ``a0`` to every ``a`` moves a shape's rim (0 for round shapes)."""
+    if period < 0:
+        return np.zeros(a.size)
+    turn = np.angle(a / a0)
+    if period > 0:
+        turn = (turn + period / 2) % period - period / 2
+    return np.abs(turn) * lever
+
+
+def _concentric(sym: int, idx: np.ndarray, nodes: Nodes, size: float, period: float) -> list[Tabulated]:
+    """Sets of at least :data:`MIN_COPIES` nodes about one centre, in document order."""
+    out: list[Tabulated] = []
+    b = nodes.b[idx]
+    slack = nodes.slack[idx]
+    q = max(float(np.min(slack)), 1e-12)
+    keys = np.column_stack([np.round(b.real / q), np.round(b.imag / q)])
+    _, inv, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+    inv = inv.ravel()
+    by_place = np.argsort(inv, kind="stable")  # document order within each place
+    bounds = np.concatenate(([0], np.cumsum(counts)))
+    for g in np.flatnonzero(counts >= MIN_COPIES):
+        members = idx[by_place[bounds[g] : bounds[g + 1]]]
+        a = nodes.a[members]
+        lever = size * np.abs(a)
+        moved = np.abs(nodes.b[members] - nodes.b[members[0]])
+        moved = moved + _turn_error(a, a[0], lever, period)
+        if np.any(moved > nodes.slack[members]):
+            continue
+        scales = np.abs(a) / abs(a[0])
+        if np.ptp(np.log(scales)) * size * abs(a[0]) <= q:
+            continue  # stacked copies of one size: the duplicates' rule codes them
+        out.append(Tabulated(sym, members, "scale", 1 + 0j, 0.0, scales[:, None]))
+    return out
+
+
+def _pose_groups(idx: np.ndarray, nodes: Nodes, size: float, period: float, q: float) -> list[np.ndarray]:
+    """Split ``idx`` into groups of one pose: scale and heading alike within ``q`` at the shape's rim."""
+    a = nodes.a[idx]
+    lever = max(size * float(np.max(np.abs(a))), 1e-300)
+    turn = np.zeros(a.size) if period < 0 else np.angle(a)
+    if period > 0:
+        turn = turn % period
+    key = np.column_stack([np.round(np.log(np.abs(a)) * lever / q), np.round(turn * lever / q)])
+    _, inv = np.unique(key, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    return [idx[inv == g] for g in range(int(inv.max(initial=-1)) + 1)]
+
+
+def _level_runs(along: np.ndarray, q: float) -> list[tuple[np.ndarray, int, float]]:
+    """Runs of evenly spaced levels holding equally many values each.
+
+    ``along`` is sorted; values within ``q`` of the previous one share a level.  Returns
+    ``(indices into along, count per level, step)`` of every run of at least
+    :data:`MIN_COPIES` levels whose places fit ``start + i·step`` within ``q``.
+    """
+    new_level = np.concatenate(([True], np.diff(along) > q))
+    starts = np.flatnonzero(new_level)
+    counts = np.diff(np.append(starts, along.size))
+    level = np.add.reduceat(along, starts) / counts
+    gaps = np.diff(level)
+    runs = []
+    i = 0
+    while i + MIN_COPIES <= level.size:
+        j = i  # extend while the level counts and the gaps stay alike (linear time)
+        while j + 1 < level.size and counts[j + 1] == counts[i] and abs(gaps[j] - gaps[i]) <= q:
+            j += 1
+        span = level[i : j + 1] - level[i]
+        k = np.arange(span.size)
+        step = span[-1] / max(j - i, 1)
+        if np.max(np.abs(span - k * step)) > q:  # the gaps drift: keep what the first gap fits
+            step = float(gaps[i]) if i < gaps.size else 0.0
+            bad = np.flatnonzero(np.abs(span - k * step) > q)
+            j = i + (int(bad[0]) - 1 if bad.size else j - i)
+        if j - i + 1 >= MIN_COPIES and step > 2 * q:
+            runs.append((np.arange(starts[i], starts[j] + counts[j]), int(counts[i]), float(step)))
+            i = j + 1
+        else:
+            i += 1
+    return runs
+
+
+def _rows(sym: int, idx: np.ndarray, nodes: Nodes, size: float, period: float) -> list[Tabulated]:
+    """Rows along a canvas axis: evenly spaced levels with as many copies each, moved across freely."""
+    out: list[Tabulated] = []
+    q = max(float(np.min(nodes.slack[idx])), 1e-12)
+    first = nodes.first_members()
+    for group in _pose_groups(idx, nodes, size, period, q):
+        free = np.ones(group.size, bool)
+        for axis in AXES:
+            members = group[free]
+            if members.size < MIN_COPIES:
+                break
+            along = (nodes.b[members] / axis).real
+            order = np.lexsort((first[members], along))
+            for at, k, step in _level_runs(along[order], q):
+                # level by level, each level's copies in document order
+                run = members[order[at]].reshape(-1, k)
+                run = np.take_along_axis(run, np.argsort(first[run], axis=1, kind="stable"), axis=1)
+                across = (nodes.b[run] / axis).imag
+                out.append(Tabulated(sym, run.ravel(), "offset", axis, step, across - across[0, 0]))
+                free[np.isin(group, run)] = False
+    return out
+
+
+def find_tabulated(table: SymbolTable, nodes: Nodes, period: np.ndarray) -> list[Tabulated]:
+    """Partly regular repetitions among ``nodes`` (disjoint), concentric copies first.
+
+    Parameters
+    ----------
+    table : SymbolTable
+        The hierarchy's symbols (their sizes).
+    nodes : Nodes
+        The live nodes; their slack bounds how far a repetition may move each.
+    period : ndarray of float
+        Rotational symmetry of every symbol: ``2π/k`` for k-fold, -1 for round, 0 for none.
+    """
+    first = nodes.first_members()
+    sizes = table.sizes
+    found: list[Tabulated] = []
+    taken = np.zeros(len(nodes), bool)
+    for sym in np.unique(nodes.sym):
+        idx = np.flatnonzero(nodes.sym == sym)
+        if idx.size < MIN_COPIES:
+            continue
+        idx = idx[np.argsort(first[idx], kind="stable")]
+        size, per = float(sizes[sym]), float(period[sym]) if sym < period.size else 0.0
+        for find in (_concentric, _rows):
+            free = idx[~taken[idx]]
+            if free.size < MIN_COPIES:
+                break
+            for t in find(int(sym), free, nodes, size, per):
+                found.append(t)
+                taken[t.nodes] = True
+    return found
+
+
+def tabulated_rule(table: SymbolTable, t: Tabulated, name: str, nodes: Nodes) -> Rule:
+    """The rule ``name(m)`` drawing repetition ``t`` when called with ``m = steps - 1`` at its first node."""
+    a0 = nodes.a[t.nodes[0]]
+    values = t.values[::-1]  # entry m is drawn by the step with counter m: the last level is entry 0
+    draws: list[Module] = []
+    if t.kind == "scale":
+        scales = Linear.of_table(nice_array(values[:, 0], rel_tol=1e-6))
+        draws += [Push(), Turtle("*", scales), *table.draw(t.sym, last=True), Pop()]
+        step: tuple[Module, ...] = ()
+    else:
+        turn = float(np.degrees(np.angle(t.axis * 1j / a0)))
+        tiny = 1e-6 * (float(np.max(np.abs(values))) + 1e-12)
+        for track in values.T / abs(a0):
+            free: tuple[Module, ...] = ()
+            if np.max(np.abs(track)) > tiny:
+                offsets = Linear.of_table(nice_array(track, abs_tol=tiny))
+                free = (Turtle("+", Linear(turn)), Turtle("f", offsets), Turtle("+", Linear(-turn)))
+            draws += [Push(), *free, *table.draw(t.sym, last=True), Pop()]
+        step = const_t(1 + 0j, t.step * t.axis / a0)
+    # one case for every m >= 0: each table is written once; P(-1) draws nothing and ends it
+    return Rule(name, True, (Case(None, (*draws, *step, Symbol(name, Count(-1, 1)))),))
+
+
+def shortens(prec: Precision, table: SymbolTable, t: Tabulated, rule: Rule, nodes: Nodes) -> bool:
+    """Whether the rule codes the repetition in fewer bits than placing its nodes one by one.
+
+    One by one, the nodes cost what they add to the set of all live nodes of their symbol (set
+    code, :func:`~lsys_core.hierarchy.mdl.placement_set_bits`).  A row is coded by its kind, symbol,
+    count, step, the direction of its offsets, their range and every offset at that range;
+    concentric copies by the rule's tokens with scales at the precision of the shape's rim.
+    """
+    token = token_bits(len(table) + 1)
+    n = t.nodes.size
+    a = nodes.a[t.nodes]
+    lever = table.sizes[t.sym] * np.abs(a)
+    _, stacks = np.unique(prec.cell_ids(nodes.b[t.nodes]), return_counts=True)
+    pose = pose_bits(*prec.pose_model(a, lever), stacks)
+    total = int(np.count_nonzero(nodes.sym == t.sym))
+    alone = placement_set_bits(prec, total, pose=pose, token=token) - placement_set_bits(
+        prec, total - n, token=token
+    )
+    call = placement_set_bits(prec, 1, token=token)
+    if t.kind == "scale":  # scales are worth the bits that move the shape's rim by eps, as in the set code
+        scales = next(m.value for m in rule.cases[0].body if isinstance(m, Turtle) and m.value.table)
+        plain = replace(rule, cases=(Case(None, tuple(m for m in rule.cases[0].body if m != scales)),))
+        lever_bits = table_bits(prec, scales.table, "*", float(np.median(lever)))
+        return bool(rule_bits(prec, token, plain) + lever_bits + call <= alone + RULE_BITS)
+    a0 = nodes.a[t.nodes[0]]
+    coded = (
+        KIND_BITS
+        + token
+        + float(count_bits(t.steps) + count_bits(t.values.shape[1]))
+        + transform_bits(prec, 1 + 0j, t.step * t.axis / a0 * abs(a0))
+        + angle_value_bits(prec, float(np.degrees(np.angle(t.axis * 1j / a0))))
+        + sum(table_bits(prec, track, "f") for track in t.values.T)
+    )
+    return bool(coded + call < alone)

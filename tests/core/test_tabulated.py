@@ -1,0 +1,82 @@
+"""Partly regular repetitions become one rule with a table value (lsys_core.hierarchy.tabulated)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lsys_core.derive.derivation import derive
+from lsys_core.grammar.model import Grammar, Turtle
+from lsys_core.pipeline import infer
+from lsys_core.testing import assert_scenes_close, drawing_scene
+from tests.core.scenes import LEAF, place, pose, scene
+
+#: A circle of radius 1 about the origin, four cubics.
+_K = 0.5522847498
+CIRCLE = np.array(
+    [
+        [1, 1 + _K * 1j, _K + 1j, 1j],
+        [1j, -_K + 1j, -1 + _K * 1j, -1],
+        [-1, -1 - _K * 1j, -_K - 1j, -1j],
+        [-1j, _K - 1j, 1 - _K * 1j, 1],
+    ]
+)
+
+
+def _table_rules(g: Grammar) -> list[str]:
+    """Names of the rules whose bodies hold a table value."""
+    return [
+        r.name
+        for r in g.rules
+        if any(isinstance(m, Turtle) and m.value.table for c in r.cases for m in c.body)
+    ]
+
+
+def _placed_by(g: Grammar, name: str) -> int:
+    """How many instances the derivation draws through rule ``name``."""
+    d = derive(g)
+    names = [r.name for r in g.rules]
+    return int(np.count_nonzero(d.rule == names.index(name)))
+
+
+def test_concentric_circles_of_irregular_radii_in_alternating_colours_are_one_rule() -> None:
+    radii = [18, 17, 13, 11, 9, 6, 2, 1]  # no progression: the paper's sequences cannot code them
+    colours = ["#191919", "#313131"] * 4
+    elements = [
+        e
+        for r, c in zip(radii, colours, strict=True)
+        for e in place(CIRCLE, [pose(50, 40, 0, r)], f"fill:{c};stroke:none")
+    ]
+    s = scene(elements, place(LEAF, [pose(5, 5)]))
+    g = infer(s).grammar
+    tables = _table_rules(g)
+    assert len(tables) == 1
+    assert _placed_by(g, tables[0]) == 8
+    assert_scenes_close(s, drawing_scene(derive(g)))
+
+
+def test_rows_of_dots_at_data_positions_are_one_rule() -> None:
+    rng = np.random.default_rng(3)
+    # a dot plot: 12 evenly spaced rows, in each a dot of two series at its own x
+    x = 100 + rng.uniform(0, 60, (12, 2))
+    frames = [pose(x[i, j], 20 + 12 * i, 0, 2.5) for j in range(2) for i in rng.permutation(12)]
+    s = scene(
+        place(CIRCLE, frames, "fill:#4c78a8;stroke:none"), place(LEAF, [pose(0, 0), pose(300, 200, 40)])
+    )
+    g = infer(s).grammar
+    tables = _table_rules(g)
+    assert len(tables) == 1
+    assert _placed_by(g, tables[0]) == 24
+    assert_scenes_close(s, drawing_scene(derive(g)))
+
+
+def test_copies_at_random_places_make_no_table_rule() -> None:
+    rng = np.random.default_rng(7)
+    frames = [pose(*xy) for xy in rng.uniform(0, 1000, (300, 2))]
+    g = infer(scene(place(LEAF, frames))).grammar
+    assert _table_rules(g) == []
+
+
+def test_copies_stacked_at_one_size_are_not_concentric() -> None:
+    frames = [pose(20, 20)] * 3 + [pose(200, 20, 30), pose(120, 150, 80)]
+    g = infer(scene(place(LEAF, frames))).grammar
+    assert _table_rules(g) == []
