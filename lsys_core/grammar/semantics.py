@@ -18,7 +18,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 
-from lsys_core.grammar.model import COND_EQ0, Grammar, Module, Rule, Symbol
+from lsys_core.grammar.model import COND_EQ0, Grammar, Module, Rule, Symbol, Turtle
 from lsys_core.grammar.runs import Control, Op, Write, merge, runs, sequence_words, signature, step_controls
 
 __all__ = ["Card", "Control", "Write", "describe", "rule_closures", "rules_under"]
@@ -137,6 +137,9 @@ def _card(g: Grammar, rule: Rule, sites: list[tuple[str, int]]) -> Card:
         kind, summary = "group", f"group of {shapes} shape{'s' if shapes != 1 else ''}"
     if len(counts) > 1 and kind != "group":
         summary += f" (counts {', '.join(str(c) for c in counts)})"
+    tables = sum(1 for c in rule.cases[:1] for m in c.body if isinstance(m, Turtle) and m.value.table)
+    if tables:
+        summary += f", {'a table' if tables == 1 else f'{tables} tables'} of values"
     count = int(reps) if reps is not None else None
     return Card(rule.name, kind, summary, terminals, calls, tuple(count_controls + controls), count)
 

@@ -63,3 +63,10 @@ def test_every_table_entry_is_a_parameter() -> None:
         set_param(g, "P.0.1.t0", 0)
     with pytest.raises(GrammarError, match="unknown parameter"):
         set_param(g, "P.0.1.t4", 1)
+
+
+def test_the_rule_card_says_the_rule_holds_a_table() -> None:
+    from lsys_core.grammar.semantics import describe
+
+    card = next(c for c in describe(parse_grammar(RINGS)) if c.owner == "P")
+    assert card.summary.endswith("a table of values")
