@@ -20,8 +20,10 @@ def _slow_echo(request, cancel, progress):
 
 def test_newest_result_wins_and_previous_job_is_cancelled(qtbot):
     seen: list[tuple[object, bool]] = []
+    inside = threading.Event()
 
     def compute(request, cancel, progress):
+        inside.set()
         try:
             return _slow_echo(request, cancel, progress)
         finally:
@@ -31,7 +33,8 @@ def test_newest_result_wins_and_previous_job_is_cancelled(qtbot):
     results = []
     runner.resultReady.connect(results.append)
     runner.submit(1)
-    qtbot.waitUntil(lambda: runner.running, timeout=120_000)
+    # job 1 is computing (not only handed to the worker thread, which may not have run yet)
+    qtbot.waitUntil(inside.is_set, timeout=120_000)
     runner.submit(2)
     runner.submit(3)
     qtbot.waitUntil(lambda: not runner.busy, timeout=120_000)
