@@ -27,7 +27,7 @@ import numpy as np
 
 from lsys_core.grammar.model import Case, Count, Linear, Module, Pop, Push, Rule, Symbol, Turtle
 from lsys_core.hierarchy.describe import rule_bits
-from lsys_core.hierarchy.emit import const_t, nice_array
+from lsys_core.hierarchy.emit import ANGLE_SNAP, const_t, nice, nice_array
 from lsys_core.hierarchy.mdl import (
     KIND_BITS,
     Precision,
@@ -237,7 +237,7 @@ def tabulated_rule(table: SymbolTable, t: Tabulated, name: str, nodes: Nodes) ->
         draws += [Push(), Turtle("*", scales), *table.draw(t.sym, last=True), Pop()]
         step: tuple[Module, ...] = ()
     else:
-        turn = float(np.degrees(np.angle(t.axis * 1j / a0)))
+        turn = nice(float(np.degrees(np.angle(t.axis * 1j / a0))), abs_tol=ANGLE_SNAP)
         tiny = 1e-6 * (float(np.max(np.abs(values))) + 1e-12)
         for track in values.T / abs(a0):
             free: tuple[Module, ...] = ()

@@ -80,3 +80,16 @@ def test_copies_stacked_at_one_size_are_not_concentric() -> None:
     frames = [pose(20, 20)] * 3 + [pose(200, 20, 30), pose(120, 150, 80)]
     g = infer(scene(place(LEAF, frames))).grammar
     assert _table_rules(g) == []
+
+
+def test_rows_of_turned_shapes_keep_their_pose() -> None:
+    rng = np.random.default_rng(5)
+    x = 100 + rng.uniform(0, 60, (14, 3))
+    # three series of an asymmetric shape, turned 30°, in 14 columns 15 apart
+    frames = [pose(20 + 15 * i, x[i, j], 30, 0.8) for i in rng.permutation(14) for j in range(3)]
+    s = scene(place(LEAF, frames))
+    g = infer(s).grammar
+    tables = _table_rules(g)
+    assert len(tables) == 1
+    assert _placed_by(g, tables[0]) == 42
+    assert_scenes_close(s, drawing_scene(derive(g)))
