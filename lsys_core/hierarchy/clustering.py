@@ -21,6 +21,10 @@ __all__ = ["group_indices", "mean_shift"]
 _BLOCK = 1 << 18
 #: Neighbours asked of the KD-tree per seed before falling back to a ball query.
 _NEAR = 8
+#: Queries of at least this many seeds run on every core: scipy starts and joins its threads
+#: at every call, and a drawing of 4,817 elements makes 5,282 mostly small calls (48 s in
+#: thread joins when every call was threaded).
+_THREADED = 20_000
 
 
 def _row_keys(cells: np.ndarray) -> np.ndarray:
@@ -54,14 +58,16 @@ def _row_keys(cells: np.ndarray) -> np.ndarray:
 def _ball_pairs(query: np.ndarray, tree: cKDTree, r: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """Return ``(i, j)`` for every point ``j`` of ``tree`` within ``r`` of ``query[i]`` (vectorised).
 
-    The :data:`_NEAR` nearest points of every query come from one ``query`` call (threads of
-    :func:`lsys_core.parallel.jobs`); only queries whose :data:`_NEAR` nearest are all within
-    ``r`` may have more, and only those go through ``sparse_distance_matrix``.  Most seeds of
+    The :data:`_NEAR` nearest points of every query come from one ``query`` call (on
+    :func:`lsys_core.parallel.jobs` threads from :data:`_THREADED` queries up); only queries
+    whose :data:`_NEAR` nearest are all within ``r`` may have more, and only those go through
+    ``sparse_distance_matrix``.  Most seeds of
     a pair space are nearly isolated: for 10^5 of them the query takes 0.20 s of CPU where
-    ``sparse_distance_matrix`` took 0.25 s, and it runs on every core.
+    ``sparse_distance_matrix`` took 0.25 s, and a large query runs on every core.
     """
     k = min(_NEAR, tree.n)
-    dist, idx = tree.query(query, k=k, distance_upper_bound=r * (1 + 1e-9), workers=parallel.jobs())
+    workers = parallel.jobs() if len(query) >= _THREADED else 1  # threads cost ~1 ms per call
+    dist, idx = tree.query(query, k=k, distance_upper_bound=r * (1 + 1e-9), workers=workers)
     dist, idx = dist.reshape(len(query), k), idx.reshape(len(query), k)
     inside = dist <= r
     full = np.flatnonzero(inside[:, -1]) if k < tree.n else np.zeros(0, np.intp)
