@@ -17,18 +17,15 @@ import numpy as np
 
 from lsys_core.cancel import CancelToken, check
 from lsys_core.instancing.deviation import pose_deviations
-from lsys_core.instancing.model import Instancing
-from lsys_core.svg.model import Element, Scene
+from lsys_core.instancing.model import Instancing, terminal_shapes
+from lsys_core.svg.model import Scene
 
 __all__ = ["deviations", "split_unfaithful"]
 
 
 def deviations(scene: Scene, inst: Instancing, *, exact: float = 0.0) -> np.ndarray:
     """Distance of every element from its terminal drawn at its pose (document units)."""
-    from lsys_core.geometry.shapes import shape_arrays
-
-    shapes = [Element(*shape_arrays(t.path)) for t in inst.terminals]
-    return pose_deviations(scene.elements, shapes, inst.group, inst.a, inst.b, exact=exact)
+    return pose_deviations(scene.elements, terminal_shapes(inst), inst.group, inst.a, inst.b, exact=exact)
 
 
 def split_unfaithful(

@@ -7,8 +7,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from lsys_core.grammar.model import Terminal
+from lsys_core.svg.model import Element
 
-__all__ = ["Instancing"]
+__all__ = ["Instancing", "terminal_shapes"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,3 +42,10 @@ class Instancing:
     symmetry: np.ndarray
     mirrored_of: np.ndarray
     deviation: np.ndarray | None = None
+
+
+def terminal_shapes(inst: Instancing) -> list[Element]:
+    """Every terminal's shape as an element in its local frame (the terminal's path data parsed)."""
+    from lsys_core.geometry.shapes import shape_arrays
+
+    return [Element(*shape_arrays(t.path)) for t in inst.terminals]

@@ -15,7 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 from lsys_core.instancing.deviation import pose_deviations
-from lsys_core.instancing.model import Instancing
+from lsys_core.instancing.model import Instancing, terminal_shapes
 from lsys_core.svg.model import Element, Scene
 
 __all__ = ["medoids", "regular_scales"]
@@ -88,14 +88,12 @@ def regular_scales(scene: Scene, inst: Instancing, tolerance: float) -> Instanci
     ``tolerance`` drawn at scale 1 (about its centroid); groups whose sizes really differ (a
     shrinking spiral) keep their scales.
     """
-    from lsys_core.geometry.shapes import shape_arrays
-
     if inst.deviation is None:
         return inst
     off = np.flatnonzero(np.abs(np.abs(inst.a) - 1.0) > 1e-9)
     if off.size == 0:
         return inst
-    shapes = [Element(*shape_arrays(t.path)) for t in inst.terminals]
+    shapes = terminal_shapes(inst)
     a1 = inst.a[off] / np.abs(inst.a[off])
     # keep the centroid of the terminal's outline where it was
     cen = np.array([np.mean(shapes[g].cubics) for g in inst.group[off]])
