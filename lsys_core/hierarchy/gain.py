@@ -213,12 +213,15 @@ def _pose_error(
     return np.abs(b_pred - nodes.b[idx]) + np.abs(a_pred) * np.abs(ratio - 1.0) * sizes[sym]
 
 
-def _chain_poses(nodes: Nodes, groups, A: complex, B: complex, lever: np.ndarray):
+def _chain_poses(nodes: Nodes, groups, A: complex, B: complex, lever: np.ndarray, own_scale: float = 0.0):
     """Poses the sequences ``P(m) -> X T P(m-1)`` derive, from the start that fits each group best.
 
     The start of every application is the pose ``(a0, b0)`` minimising the squared
     displacements (positions, and turns/scales at each node's ``lever``) of all its nodes, not
     the first node's own pose: a jittered first element would otherwise tilt the whole row.
+    A start whose scale is within the relative ``own_scale`` of its first node's keeps that
+    node's scale (only its turn and place are fitted): a rule does not start at a scale of
+    1.00002 to absorb rounding.
     """
     idx = np.concatenate(groups)
     owner = np.repeat(np.arange(len(groups)), [g.size for g in groups])
@@ -241,6 +244,10 @@ def _chain_poses(nodes: Nodes, groups, A: complex, B: complex, lever: np.ndarray
         (rhs_a * count - np.conj(sv) * rhs_b) / np.where(ok, det, 1.0),
         nodes.a[idx[np.searchsorted(owner, np.arange(n))]],
     )
+    if own_scale > 0.0:
+        own = np.abs(nodes.a[idx[np.searchsorted(owner, np.arange(n))]])
+        near = ok & (np.abs(np.abs(a0) - own) <= own_scale * own) & (np.abs(a0) > 0)
+        a0 = np.where(near, a0 / np.where(near, np.abs(a0), 1.0) * own, a0)
     b0 = np.where(
         ok, (rhs_b - sv * a0) / np.maximum(count, 1), nodes.b[idx[np.searchsorted(owner, np.arange(n))]]
     )
@@ -278,7 +285,7 @@ def _tree_poses(nodes: Nodes, c: BranchCandidate):
 
 
 def placement_error(
-    c: Candidate, nodes: Nodes, sizes: np.ndarray, period: np.ndarray
+    c: Candidate, nodes: Nodes, sizes: np.ndarray, period: np.ndarray, *, own_scale: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray] | None, tuple[np.ndarray, np.ndarray]]:
     """Distance between every node of ``c`` and where the candidate's rule would derive it.
 
@@ -293,6 +300,9 @@ def placement_error(
     period : ndarray
         Per symbol, the rotation (radians) that maps its shape onto itself: 0 for none,
         negative for any rotation (a circle).
+    own_scale : float
+        Sequences and pairs whose best start is within this relative scale of their first
+        node's start at that node's scale (see :func:`_chain_poses`).
 
     Returns
     -------
@@ -307,7 +317,7 @@ def placement_error(
     starts = None
     if isinstance(c, (SeqCandidate, PairCandidate)):
         lever = sizes[nodes.sym[np.concatenate(c.groups)]]
-        idx, pa, pb, starts = _chain_poses(nodes, c.groups, c.A, c.B, lever)
+        idx, pa, pb, starts = _chain_poses(nodes, c.groups, c.A, c.B, lever, own_scale)
     elif isinstance(c, LinearCandidate):
         idx, pa, pb = _linear_poses(nodes, c)
     elif isinstance(c, BranchCandidate):

@@ -15,9 +15,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from lsys_core.hierarchy.candidates import BranchCandidate, Candidate, PairCandidate, SeqCandidate
-from lsys_core.hierarchy.gain import Ledger, placement_error
+from lsys_core.hierarchy.gain import Ledger, group_reach, placement_error
 from lsys_core.hierarchy.nodes import Nodes
-from lsys_core.hierarchy.snap import plainer, snapped
+from lsys_core.hierarchy.snap import SHARE, plainer, snapped
 from lsys_core.settings import setting
 
 __all__ = ["WEAK_COVER", "Measure", "Weights", "choose", "importance_order", "scores", "worthwhile"]
@@ -93,17 +93,35 @@ def _admitted(
     n_terminals: int,
     limit: float,
 ) -> Candidate | None:
-    """``c`` with its slack, starts and gain set, if it places its nodes within their slack and pays."""
-    idx, err, starts, (pa, pb) = placement_error(c, nodes, sizes, period)
-    left = nodes.slack[idx] - err
-    over = np.flatnonzero(left < 0.0)
-    if over.size and measure is not None:
-        single = np.array([nodes.members[i].size == 1 for i in idx[over]]) & (
-            nodes.sym[idx[over]] < n_terminals
-        )
-        if single.all():
-            elements = np.array([int(nodes.members[i][0]) for i in idx[over]])
-            left[over] = limit - measure(elements, pa[over], pb[over])
+    """``c`` with its slack, starts and gain set, if it places its nodes within their slack and pays.
+
+    A sequence or pair whose best start differs from its first node's scale by rounding only
+    (what :data:`~lsys_core.hierarchy.snap.SHARE` of the tolerance allows at its reach) starts
+    at that node's scale when every node still fits.
+    """
+
+    def fit(own_scale: float):
+        idx, err, starts, (pa, pb) = placement_error(c, nodes, sizes, period, own_scale=own_scale)
+        left = nodes.slack[idx] - err
+        over = np.flatnonzero(left < 0.0)
+        if over.size and measure is not None:
+            single = np.array([nodes.members[i].size == 1 for i in idx[over]]) & (
+                nodes.sym[idx[over]] < n_terminals
+            )
+            if single.all():
+                elements = np.array([int(nodes.members[i][0]) for i in idx[over]])
+                left[over] = limit - measure(elements, pa[over], pb[over])
+        return left, starts
+
+    left, starts = fit(0.0)
+    if starts is not None and not (left < 0.0).any() and np.isfinite(limit):
+        own = np.abs(nodes.a[[int(g[0]) for g in c.groups]])
+        off = np.abs(np.abs(starts[0]) - own) / np.maximum(own, 1e-300)
+        snap = SHARE * limit / max(float(group_reach(nodes, c.groups).max()), 1e-12)
+        if ((off > 0.0) & (off <= snap)).any():
+            plain, plain_starts = fit(snap)
+            if not (plain < 0.0).any():
+                left, starts = plain, plain_starts
     gain = ledger.gain(c) if not (left < 0.0).any() else 0.0
     if gain <= 0.0:
         return None

@@ -79,13 +79,13 @@ def drawing_to_structured_svg(drawing: Drawing, *, head=None) -> str:
     ids = _Ids(_ID.findall(extra_xml) + [v for k, v in (head.attributes if head else ()) if k == "id"])
     out = [_root(drawing, head)]
     symbol = np.asarray(drawing.symbol, np.intp).reshape(n)
-    a = np.asarray(drawing.a, complex).reshape(n)
     b = np.asarray(drawing.b, complex).reshape(n)
+    a = _unturned_circles(drawing, symbol, np.asarray(drawing.a, complex).reshape(n))
     styles, style = drawing.instance_styles()
     style = np.asarray(style, np.intp).reshape(n)
     baked = np.array(["url(" in s for s in styles] + [False], bool)[style] if n else np.zeros(0, bool)
     scale = drawing.stroke_scale() if n else np.zeros(0)
-    uses, defs = _uses(drawing, symbol, style, styles, scale, ~baked, ids)
+    uses, defs = _uses(drawing, a, symbol, style, styles, scale, ~baked, ids)
     defs_xml = drawing.defs.strip()
     if defs_xml.startswith("<defs"):
         defs_xml = defs_xml[defs_xml.index(">") + 1 : defs_xml.rindex("</defs>")].strip()
@@ -174,7 +174,23 @@ def _stroked(decls: dict[str, str]) -> dict[str, str]:
     return decls
 
 
-def _uses(drawing, symbol, style, styles, scale, plain, ids: _Ids) -> tuple[_Uses, list[str]]:
+def _unturned_circles(drawing: Drawing, symbol: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """The poses ``a`` with the turns of circles about their own centre taken out (they do not show).
+
+    An inferred ring of round dots turns each dot as it goes round; written as a ``<circle>``
+    with no ``rotate`` the instance is shorter and reads as the dot it is.
+    """
+    a = a.copy()
+    for t, term in enumerate(drawing.terminals):
+        shape = primitive(term.path)
+        if shape is None or shape[0] != "circle" or float(shape[1]["cx"]) != 0 or float(shape[1]["cy"]) != 0:
+            continue
+        mine = symbol == t
+        a[mine] = np.abs(a[mine])
+    return a
+
+
+def _uses(drawing, a_all, symbol, style, styles, scale, plain, ids: _Ids) -> tuple[_Uses, list[str]]:
     """Choose each terminal's definition and each instance's ``<use>`` format (style part)."""
     n = symbol.size
     key = np.zeros(n, np.intp)
@@ -194,7 +210,7 @@ def _uses(drawing, symbol, style, styles, scale, plain, ids: _Ids) -> tuple[_Use
             common = {k: v for k, v in common.items() if k not in _LENGTH_KEYS}
         term = drawing.terminals[t]
         ref = ids.get(term.name)
-        a = drawing.a[mine]
+        a = a_all[mine]
         turned = bool((np.abs(a.imag) > 1e-9 * np.abs(a)).any() or (a.real < 0).any())
         path_only = turned or any(k in d for d in finals for k in _PATH_ONLY)
         defs.append(_definition(term.path, ref, common, path_only))
