@@ -19,7 +19,6 @@ from dataclasses import replace
 import numpy as np
 
 from lsys_core.instancing.deviation import pose_deviations
-from lsys_core.instancing.merge import without_groups
 from lsys_core.instancing.model import Instancing
 from lsys_core.instancing.sampling import arc_fractions, sample_elements
 from lsys_core.svg.model import Element
@@ -156,10 +155,32 @@ def merge_round(
             gone.add(h)
     if not gone:
         return inst
-    return without_groups(replace(inst, group=group, a=a, b=b, deviation=dev), sorted(gone))
+    return _without_groups(replace(inst, group=group, a=a, b=b, deviation=dev), sorted(gone))
 
 
 def _rms_radius(shape: Element) -> float:
     """Root mean square distance of the outline from the origin."""
     pts = sample_elements([shape], arc_fractions(_RADIAL)).points[0]
     return float(np.sqrt(np.mean(np.abs(pts) ** 2)))
+
+
+def _without_groups(inst: Instancing, gone: list[int]) -> Instancing:
+    """``inst`` without the (now empty) groups ``gone``: terminals renumbered and renamed, mirror links kept."""
+    from lsys_core.instancing.similarity import terminal_name
+
+    k = len(inst.terminals)
+    keep = np.setdiff1d(np.arange(k), gone)
+    new = np.full(k, -1)
+    new[keep] = np.arange(keep.size)
+    mirrored = np.where(inst.mirrored_of[keep] >= 0, new[np.maximum(inst.mirrored_of[keep], 0)], -1)
+    terminals = tuple(
+        replace(inst.terminals[g], name=terminal_name(i), mirror_of=terminal_name(m) if m >= 0 else None)
+        for i, (g, m) in enumerate(zip(keep.tolist(), mirrored.tolist(), strict=True))
+    )
+    return replace(
+        inst,
+        group=new[inst.group],
+        terminals=terminals,
+        symmetry=inst.symmetry[keep],
+        mirrored_of=mirrored,
+    )

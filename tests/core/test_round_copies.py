@@ -13,7 +13,6 @@ from lsys_core.instancing.orientation import ring_headings
 from lsys_core.instancing.roundness import round_within, turn_deviation
 from lsys_core.pipeline import infer
 from lsys_core.render.structured import drawing_to_structured_svg
-from lsys_core.svg import parse_svg
 from lsys_core.svg.model import Element
 from lsys_core.testing import drawing_scene, hausdorff_rel
 
@@ -126,74 +125,3 @@ def test_a_ring_of_circles_is_one_constant_sequence_written_as_circles() -> None
     assert r.log == ("P1: 1 sequences of A, lengths [8]",)
     svg = drawing_to_structured_svg(derive(r.grammar))
     assert "<circle" in svg and "rotate(" not in svg
-
-
-def _window_row(n: int = 6) -> bytes:
-    """A row of ``n`` windows drawn two ways: a polygon, and a path whose top edge is a stray curve.
-
-    The two drawings differ by less than a tenth of a unit, but their outlines are
-    parametrised so differently that the sample voting of §4.1 does not pair them.
-    """
-    parts = []
-    for k in range(n):
-        x = 16.0 * k
-        if k % 2:
-            parts.append(
-                f'<path d="M{42.1 + x},86.02v7.86h4.65v-7.86C{46.75 + x},86.02,{42.04 + x},86.08,'
-                f'{42.1 + x},86.02z" fill="#2f2f2f"/>'
-            )
-        else:
-            parts.append(
-                f'<polygon points="{33.66 + x},86.02 {38.77 + x},86.02 {38.77 + x},93.81 {33.59 + x},93.81"'
-                ' fill="#2f2f2f"/>'
-            )
-    parts.append('<rect x="0" y="0" width="128" height="128" fill="none" stroke="#000"/>')
-    return (
-        '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 128 128">' + "".join(parts) + "</svg>"
-    ).encode()
-
-
-def test_copies_drawn_differently_share_a_terminal_within_the_tolerance() -> None:
-    sc = parse_svg(_window_row())
-    r = infer(sc)
-    assert len(r.grammar.terminals) == 2  # the windows, and the frame
-    assert r.log[-2] == "P1: 1 sequences of X1, lengths [3]", r.log  # a row of three pairs of windows
-    assert r.max_deviation <= r.tolerance
-    assert hausdorff_rel(sc, drawing_scene(derive(r.grammar))) <= 0.005
-
-
-def _rect(w: float, h: float, reverse: bool = False) -> np.ndarray:
-    """A ``w`` by ``h`` rectangle about the origin as four straight cubics (optionally drawn the other way)."""
-    corners = np.array([-w - h * 1j, w - h * 1j, w + h * 1j, -w + h * 1j]) / 2
-    corners = corners[::-1] if reverse else corners
-    ends = np.roll(corners, -1)
-    return np.stack([corners, (2 * corners + ends) / 3, (corners + 2 * ends) / 3, ends], axis=1)
-
-
-def test_merge_within_joins_near_identical_groups_of_one_size_only() -> None:
-    from lsys_core.geometry.paths import d_from_cubics
-    from lsys_core.grammar.model import Terminal
-    from lsys_core.instancing.fidelity import deviations
-    from lsys_core.instancing.merge import merge_within
-    from lsys_core.svg.model import Scene
-
-    shapes = [_rect(4.8, 7.8), _rect(5.0, 7.8, reverse=True), _rect(9.6, 15.6)]
-    where = [10 + 10j, 30 + 10j, 50 + 10j, 80 + 10j]
-    which = np.array([0, 0, 1, 2])
-    elements = tuple(_closed(place(shapes[k] + z, [(1 + 0j, 0j)])) for k, z in zip(which, where, strict=True))
-    sc = Scene(tuple(e[0] for e in elements))
-    terms = tuple(
-        Terminal(n, d_from_cubics(s, np.zeros(4, int), (True,))) for n, s in zip("ABC", shapes, strict=True)
-    )
-    inst = Instancing(which, np.ones(4, complex), np.array(where), terms, np.array([2, 2, 2]), np.full(3, -1))
-    inst = replace(inst, deviation=deviations(sc, inst))
-    out = merge_within(sc, inst, tolerance=0.5)
-    assert out.group.tolist() == [
-        0,
-        0,
-        0,
-        1,
-    ]  # the other way round and 0.2 wider: a copy; twice as large: not
-    assert [t.name for t in out.terminals] == ["A", "B"]
-    assert out.deviation is not None and 0.05 < out.deviation[2] <= 0.25
-    assert merge_within(sc, inst, tolerance=0.1).group.tolist() == [0, 0, 1, 2]  # beyond the tolerance
