@@ -27,8 +27,10 @@ from lsys_core.hierarchy.postprocess import simplify
 from lsys_core.hierarchy.rules import Hierarchy, Tolerance, Weights, build_hierarchy
 from lsys_core.hierarchy.snap import SHARE
 from lsys_core.instancing.fidelity import split_unfaithful
-from lsys_core.instancing.model import Instancing
-from lsys_core.instancing.orientation import unwrap_symmetric
+from lsys_core.instancing.merge import merge_within
+from lsys_core.instancing.model import Instancing, terminal_shapes
+from lsys_core.instancing.orientation import ring_headings, unwrap_symmetric
+from lsys_core.instancing.roundness import merge_round, round_within
 from lsys_core.report import InferenceResult, bounds, deviation, element_circles, measurer, reproduction_error
 from lsys_core.settings import RELAXED, InferenceSettings
 from lsys_core.svg.model import Scene
@@ -92,7 +94,10 @@ def _instancing(scene: Scene, settings: InferenceSettings, tolerance: float, can
     inst = detect_similarity(scene, threshold=settings.similarity, cancel=cancel, progress=progress)
     check(cancel)
     inst = split_unfaithful(scene, inst, tolerance=tolerance, threshold=settings.similarity, cancel=cancel)
-    return regular_scales(scene, medoids(scene, inst, tolerance), tolerance)
+    inst = merge_within(scene, inst, tolerance)
+    inst = regular_scales(scene, medoids(scene, inst, tolerance), tolerance)
+    inst = round_within(terminal_shapes(inst), inst, tolerance)
+    return merge_round(scene.elements, terminal_shapes(inst), inst, tolerance)
 
 
 def paint_like_input(grammar: Grammar, scene: Scene, inst: Instancing) -> Grammar:
@@ -206,7 +211,7 @@ def analyse(
     np.maximum.at(sizes, inst.group, radius / np.maximum(np.abs(inst.a), 1e-300))
     t = time.perf_counter()
     prec = Precision.of_box(*box, eps)
-    inst = unwrap_symmetric(inst)
+    inst = ring_headings(unwrap_symmetric(inst), eps)
     offsets = estimate_pivots(inst, sizes, tolerance=prec.eps)
     inst = recenter(inst, offsets)
     sizes = sizes + np.abs(offsets)  # how far each shape reaches from its (moved) origin

@@ -129,6 +129,8 @@ def estimate_pivots(
     rng = np.random.default_rng(seed)
     out = np.zeros(len(inst.terminals), complex)
     for g in range(len(inst.terminals)):
+        if inst.symmetry[g] == 0:
+            continue  # a round shape turns about its centre unseen: moving its origin would show turns
         sel = np.flatnonzero(inst.group == g)
         out[g] = _common_pivot(inst.a[sel], inst.b[sel], float(sizes[g]), tolerance)
         if out[g] == 0 and sel.size >= 5:

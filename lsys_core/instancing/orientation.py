@@ -20,7 +20,7 @@ from scipy.spatial import cKDTree
 
 from lsys_core.instancing.model import Instancing
 
-__all__ = ["unwrap_symmetric"]
+__all__ = ["ring_headings", "unwrap_symmetric"]
 
 
 def _unwrap_group(a: np.ndarray, b: np.ndarray, period: float) -> np.ndarray:
@@ -60,4 +60,57 @@ def unwrap_symmetric(inst: Instancing) -> Instancing:
             continue
         theta = _unwrap_group(inst.a[sel], inst.b[sel], 2 * np.pi / order)
         a[sel] = np.abs(inst.a[sel]) * np.exp(1j * theta)
+    return replace(inst, a=a)
+
+
+def _circle(z: np.ndarray) -> tuple[complex, float]:
+    """Least-squares circle through the points ``z`` (Kåsa's algebraic fit): centre and radius."""
+    m = np.column_stack([z.real, z.imag, np.ones(z.size)])
+    rhs = np.abs(z) ** 2
+    (p, q, r), *_ = np.linalg.lstsq(m, rhs, rcond=None)
+    c = complex(p / 2.0, q / 2.0)
+    return c, float(np.sqrt(max(r + abs(c) ** 2, 0.0)))
+
+
+def _on_a_ring(b: np.ndarray, tolerance: float) -> complex | None:
+    """The centre of the circle the points ``b`` lie on within ``tolerance``, or None.
+
+    Points on a line (within the tolerance) are a row, not a ring; a circle much larger than
+    the spread of the points is a bent row.
+    """
+    if b.size < 3:
+        return None
+    z = b - b.mean()
+    _, _, vt = np.linalg.svd(np.column_stack([z.real, z.imag]), full_matrices=False)
+    across = np.abs(z.real * vt[-1, 0] + z.imag * vt[-1, 1])
+    if across.max() <= tolerance:
+        return None
+    c, radius = _circle(b)
+    spread = float(np.abs(z).max())
+    if not np.isfinite(radius) or radius > 4.0 * spread or np.abs(np.abs(b - c) - radius).max() > tolerance:
+        return None
+    if np.abs(b - c).min() <= tolerance:
+        return None  # a point at the centre has no direction
+    return c
+
+
+def ring_headings(inst: Instancing, tolerance: float) -> Instancing:
+    """Turn the instances of round terminals that lie on a ring to face away from its centre.
+
+    A round terminal (symmetry order 0) shows no rotation, so its instances carry none and
+    neighbours on a ring are related by a different shift each: the ring is not a constant
+    transform.  Facing every instance away from the ring's centre makes it one (a turn of
+    ``360°/n`` and a step), which a single sequence rule writes.  The drawing does not change:
+    the terminal stays round (order 0), its rotation about its centre unseen.
+    """
+    a = inst.a.copy()
+    for g, order in enumerate(np.asarray(inst.symmetry)):
+        if order != 0:
+            continue
+        sel = np.flatnonzero(inst.group == g)
+        c = _on_a_ring(inst.b[sel], tolerance)
+        if c is None:
+            continue
+        u = inst.b[sel] - c
+        a[sel] = np.abs(inst.a[sel]) * u / np.abs(u)
     return replace(inst, a=a)
