@@ -61,9 +61,9 @@ def _ball_pairs(query: np.ndarray, tree: cKDTree, r: float = 1.0) -> tuple[np.nd
     The :data:`_NEAR` nearest points of every query come from one ``query`` call (on
     :func:`lsys_core.parallel.jobs` threads from :data:`_THREADED` queries up); only queries
     whose :data:`_NEAR` nearest are all within ``r`` may have more, and only those go through
-    ``sparse_distance_matrix``.  Most seeds of
-    a pair space are nearly isolated: for 10^5 of them the query takes 0.20 s of CPU where
-    ``sparse_distance_matrix`` took 0.25 s, and a large query runs on every core.
+    ``sparse_distance_matrix``.  Most seeds of a pair space are nearly isolated: for 10^5 of
+    them the query takes 0.20 s of CPU where ``sparse_distance_matrix`` took 0.25 s, and a
+    large query runs on every core.
     """
     k = min(_NEAR, tree.n)
     workers = parallel.jobs() if len(query) >= _THREADED else 1  # threads cost ~1 ms per call
