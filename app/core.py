@@ -10,12 +10,14 @@ imports Qt (the inference worker process uses this module too).
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Iterator
 from typing import Any
 
 __all__ = [
     "axiom_count",
     "default_settings",
     "describe",
+    "describe_iter",
     "drawing_bounds",
     "export_png",
     "export_svg",
@@ -144,6 +146,13 @@ def describe(grammar: Any) -> tuple:
     from lsys_core.grammar.semantics import describe as _describe
 
     return _describe(grammar)
+
+
+def describe_iter(grammar: Any) -> Iterator[Any]:
+    """Yield the cards of :func:`describe` one by one."""
+    from lsys_core.grammar.semantics import describe_iter as _describe_iter
+
+    return _describe_iter(grammar)
 
 
 def rules_under(grammar: Any, name: str) -> set[str]:

@@ -69,12 +69,18 @@ class _Card(QFrame):
         self.fold.setCheckable(True)
         self.fold.setAutoRaise(True)
         self.fold.toggled.connect(lambda _on: self._refresh())
+        self.name = QLabel(self)
+        self.name.setTextFormat(Qt.TextFormat.PlainText)
+        bold = self.name.font()
+        bold.setBold(True)
+        self.name.setFont(bold)
         self.title = QLabel(self)
-        self.title.setTextFormat(Qt.TextFormat.RichText)
+        self.title.setTextFormat(Qt.TextFormat.PlainText)
         self.title.setWordWrap(True)
         head = QHBoxLayout()
         head.setContentsMargins(0, 0, 0, 0)
         head.addWidget(self.fold)
+        head.addWidget(self.name)
         head.addWidget(self.title, 1)
         self.thumbs = QHBoxLayout()
         self.thumbs.setContentsMargins(22, 0, 0, 0)
@@ -107,7 +113,8 @@ class _Card(QFrame):
         self.limit = ROWS_PER_PAGE
         name = "Start (axiom)" if card.owner == "axiom" else card.owner
         summary = card.summary.split(": ", 1)[-1] if card.owner == "axiom" else card.summary
-        self.title.setText(f"<b>{name}</b> — {summary}")
+        self.name.setText(name)
+        self.title.setText("— " + summary)
         self.fold.blockSignals(True)
         self.fold.setChecked(open_)
         self.fold.blockSignals(False)
@@ -135,7 +142,7 @@ class _Card(QFrame):
     def update_values(self, card: Any) -> None:
         """Show the values of ``card`` (same controls as shown) without rebuilding."""
         self.card = card
-        self.title.setText(self.title.text().split(" — ", 1)[0] + " — " + card.summary.split(": ", 1)[-1])
+        self.title.setText("— " + card.summary.split(": ", 1)[-1])
         for (line, _label, row), ctl in zip(self.lines, card.controls, strict=False):
             if not line.isHidden() and not row.slider.isSliderDown() and not row.spin.hasFocus():
                 row.set_value(ctl.value)

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from lsys_core.grammar.model import COND_EQ0, Grammar, Module, Rule, Symbol, Turtle
 from lsys_core.grammar.runs import Control, Op, Write, merge, runs, sequence_words, signature, step_controls
 
-__all__ = ["Card", "Control", "Write", "describe", "rule_closures", "rules_under"]
+__all__ = ["Card", "Control", "Write", "describe", "describe_iter", "rule_closures", "rules_under"]
 
 
 @dataclass(frozen=True)
@@ -169,6 +169,11 @@ def describe(g: Grammar) -> tuple[Card, ...]:
     tuple of Card
         The axiom's card ("start") first, its controls placing what it draws.
     """
+    return tuple(describe_iter(g))
+
+
+def describe_iter(g: Grammar) -> Iterator[Card]:
+    """Yield the cards of :func:`describe` one by one (an editor can interleave other work)."""
     sites = _call_sites(g)
     terms = {t.name for t in g.terminals}
     drawn = [m.name for m in g.axiom if isinstance(m, Symbol)]
@@ -176,7 +181,7 @@ def describe(g: Grammar) -> tuple[Card, ...]:
     seen: dict[str, int] = {}
     for end, run in runs("axiom", 0, g.axiom):
         axiom_controls += step_controls(run, _place_prefix(end, g.axiom, seen))
-    start = Card(
+    yield Card(
         "axiom",
         "start",
         "start: " + (", ".join(dict.fromkeys(drawn)) or "nothing"),
@@ -184,7 +189,8 @@ def describe(g: Grammar) -> tuple[Card, ...]:
         tuple(sorted(set(drawn) - terms)),
         tuple(merge(axiom_controls)),
     )
-    return (start, *(_card(g, r, sites.get(r.name, [])) for r in g.rules))
+    for r in g.rules:
+        yield _card(g, r, sites.get(r.name, []))
 
 
 def rules_under(g: Grammar, name: str) -> set[str]:

@@ -49,3 +49,20 @@ def test_rows_are_reused_for_the_next_grammar_and_edits_are_forwarded(qtbot):
     row = panel.rows["axiom.0.1.v"]
     row.spin.setValue(12.5)
     assert edits == [("axiom.0.1.v", 12.5)]
+
+
+def test_sections_are_configured_a_few_per_turn_and_an_interrupted_run_is_redone(qtbot):
+    from app.params_panel import SECTIONS_PER_STEP
+
+    panel = ParamsPanel()
+    qtbot.addWidget(panel)
+    old, new = many(120), many(120, shift=5)
+    steps = panel.param_steps(old)
+    next(steps)  # the first turn configures one batch of sections only
+    configured = [s for s in panel._sections if not s.isHidden()]
+    assert len(configured) == SECTIONS_PER_STEP < 121
+    panel.set_params(new)  # a newer grammar before the run ended: everything again, new values
+    assert sum(not s.isHidden() for s in panel._sections) == 121
+    first = next(iter(panel.rows))
+    assert panel.rows[first].value() == pytest.approx(panel.current(new[0]).value)
+    assert panel.current(new[0]).value == new[0].value

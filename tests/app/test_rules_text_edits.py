@@ -1,0 +1,55 @@
+"""The rules text replaces only the lines that changed, so the others keep layout and colours."""
+
+from __future__ import annotations
+
+import random
+
+import pytest
+
+from app import rules_panel
+from app.rules_panel import RulesEditor
+
+
+def revisions(editor: RulesEditor) -> list[int]:
+    doc = editor.document()
+    return [doc.findBlockByNumber(i).revision() for i in range(doc.blockCount())]
+
+
+def test_a_changed_number_touches_only_its_line(qtbot):
+    editor = RulesEditor()
+    qtbot.addWidget(editor)
+    lines = ["lsys 1", 'terminal A "M 0 0 L 4 0 Z"', "axiom: P(3)"]
+    lines += [f"P{i}(m): m > 0 -> A f({i}) P{i}(m-1)" for i in range(50)]
+    editor.replace_text("\n".join(lines))
+    before = revisions(editor)
+    lines[20] = lines[20].replace("f(17)", "f(17.5)")
+    editor.replace_text("\n".join(lines))
+    after = revisions(editor)
+    assert editor.toPlainText() == "\n".join(lines)
+    changed = [i for i, (a, b) in enumerate(zip(before, after, strict=True)) if a != b]
+    assert changed == [20]
+
+
+@pytest.mark.parametrize("diff_lines", [rules_panel._DIFF_LINES, 0])
+def test_any_sequence_of_texts_is_shown_exactly(qtbot, monkeypatch, diff_lines):
+    monkeypatch.setattr(rules_panel, "_DIFF_LINES", diff_lines)  # 0: one span, as for long texts
+    editor = RulesEditor()
+    qtbot.addWidget(editor)
+    rnd = random.Random(7)
+    words = ["a", "bb", "", "ccc x", "é", "\U0001f600 z", "P(m) -> A"]
+    text = ""
+    for _ in range(400):
+        lines = (
+            [rnd.choice(words) for _ in range(rnd.randint(0, 9))] if rnd.random() < 0.2 else text.split("\n")
+        )
+        for _ in range(rnd.randint(0, 3)):
+            op = rnd.random()
+            if op < 0.3 and lines:
+                del lines[rnd.randrange(len(lines))]
+            elif op < 0.6:
+                lines.insert(rnd.randint(0, len(lines)), rnd.choice(words))
+            elif lines:
+                lines[rnd.randrange(len(lines))] = rnd.choice(words)
+        text = "\n".join(lines)
+        editor.replace_text(text)
+        assert editor.toPlainText() == text
