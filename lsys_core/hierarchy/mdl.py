@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from scipy.special import gammaln
@@ -45,6 +46,7 @@ __all__ = [
     "placement_set_bits",
     "pose_bits",
     "shape_bits",
+    "stack_table",
     "table_bits",
     "token_bits",
     "transform_bits",
@@ -161,10 +163,27 @@ def pose_bits(headings: float, scale: float, stacks) -> float:
     return bits
 
 
+def stack_table(headings: float, kmax: int) -> np.ndarray:
+    """``log2 C(max(headings, k), k)`` for the stacks ``k = 0 … kmax``: what :func:`pose_bits` sums.
+
+    ``table[stacks].sum()`` is bit for bit ``pose_bits``' sum of the same terms (the same values
+    in the same order), without a ``gammaln`` per cell: a ledger sums the stacks of a whole
+    family at every candidate it prices (see :class:`~lsys_core.hierarchy.gain.Ledger`).
+    """
+    k = np.arange(int(kmax) + 1, dtype=float)
+    return log2_binom(np.maximum(headings, k), k)
+
+
 def log2_binom(n: float, k):
     """``log2`` of the binomial coefficient ``C(n, k)`` (real ``n``; ``k`` scalar or array)."""
     k = np.asarray(k, dtype=float)
     return (gammaln(n + 1.0) - gammaln(k + 1.0) - gammaln(n - k + 1.0)) / math.log(2.0)
+
+
+@lru_cache(maxsize=1 << 16)
+def _log2_binom_scalar(n: float, k: float) -> float:
+    """:func:`log2_binom` of one ``(n, k)``, remembered: the same few counts come back at every candidate."""
+    return float(log2_binom(n, k))
 
 
 def count_bits(m) -> np.ndarray:
@@ -198,6 +217,8 @@ def placement_set_bits(prec: Precision, n, *, occupied=None, pose=0.0, counts=0.
     token : float
         Bits naming the symbol once.
     """
+    if np.ndim(n) == 0 and np.ndim(occupied) == 0 and np.ndim(pose) == 0 and np.ndim(counts) == 0:
+        return _placement_set_bits_scalar(prec, float(n), occupied, float(pose), float(counts), token)
     n = np.asarray(n, dtype=float)
     u = n if occupied is None else np.clip(np.asarray(occupied, dtype=float), np.minimum(n, 1.0), n)
     cells = np.maximum(prec.cells, 2.0 * u)
@@ -205,6 +226,21 @@ def placement_set_bits(prec: Precision, n, *, occupied=None, pose=0.0, counts=0.
     bits = token + log2_binom(cells, u) + stack + counts + pose
     out = np.where(n > 0, bits, 0.0)
     return float(out) if out.ndim == 0 else out
+
+
+def _placement_set_bits_scalar(
+    prec: Precision, n: float, occupied, pose: float, counts: float, token: float
+) -> float:
+    """:func:`placement_set_bits` of one set, in the same operations on Python floats.
+
+    The ledger prices ~10^5 single sets for a drawing of 5,000 elements; through 0-d arrays and
+    two ``gammaln`` calls each they took 10 s of its 45 s of rule choice.
+    """
+    u = n if occupied is None else min(max(float(occupied), min(n, 1.0)), n)
+    cells = max(prec.cells, 2.0 * u)
+    stack = _log2_binom_scalar(max(n - 1.0, 0.0), max(u - 1.0, 0.0)) if u < n else 0.0
+    bits = token + _log2_binom_scalar(cells, u) + stack + counts + pose
+    return bits if n > 0 else 0.0
 
 
 def shape_bits(prec: Precision, n_segments, radius) -> np.ndarray:

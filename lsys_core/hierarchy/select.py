@@ -71,6 +71,8 @@ def worthwhile(
     too coarse for single elements (hand-drawn copies: shape and pose noise add up on paper,
     not on the page), ``measure`` tells how far the derived element really is.
     """
+    if ledger.ceiling(c) <= 0.0:
+        return None  # whatever its numbers, it cannot pay (most candidates: rounding them costs more)
     c = snapped(c, nodes, limit, snap)
     if not _invertible(c):
         return None  # a transform that collapses its copies to a point places nothing
@@ -113,6 +115,9 @@ def _admitted(
                 left[over] = limit - measure(elements, pa[over], pb[over])
         return left, starts
 
+    gain = ledger.gain(c)  # it does not depend on the fit: most candidates fail here, before fitting
+    if gain <= 0.0:
+        return None
     left, starts = fit(0.0)
     if starts is not None and not (left < 0.0).any() and np.isfinite(limit):
         own = np.abs(nodes.a[[int(g[0]) for g in c.groups]])
@@ -122,8 +127,7 @@ def _admitted(
             plain, plain_starts = fit(snap)
             if not (plain < 0.0).any():
                 left, starts = plain, plain_starts
-    gain = ledger.gain(c) if not (left < 0.0).any() else 0.0
-    if gain <= 0.0:
+    if (left < 0.0).any():
         return None
     owner = np.repeat(np.arange(len(c.groups)), [g.size for g in c.groups])
     slack = np.full(len(c.groups), np.inf)
