@@ -15,7 +15,10 @@ from lsys_core.svg.paint import paint_declarations, parse_paint, scale_of, strok
 from lsys_core.svg.records import Ctx, paint_order
 from lsys_core.svg.resources import Box
 
-__all__ = ["shape_declarations"]
+__all__ = ["DeclarationMemo", "shape_declarations"]
+
+#: Distinct styles a :class:`DeclarationMemo` keeps (it starts again when full).
+MEMO_SIZE = 4096
 
 
 def shape_declarations(
@@ -64,3 +67,42 @@ def shape_declarations(
     if mask:
         decls["mask"] = f"url(#{mask})"
     return decls
+
+
+class DeclarationMemo:
+    """:func:`shape_declarations` of shapes whose declarations depend only on their style.
+
+    Charts, maps and patterns draw thousands of shapes with a few styles: reading 20,000 leaves
+    spent 1.5 of 6.7 profiled seconds here.  A shape's declarations are reused when it has no
+    paint server, clip path, mask or context paint (those depend on its box or its place) and
+    its style, stroke scale and viewport equal an earlier shape's.  The caller gets its own copy.
+    """
+
+    def __init__(self) -> None:
+        self._memo: dict[tuple, dict[str, str]] = {}
+
+    def get(
+        self, defs: Definitions, style: dict[str, str], ctx: Ctx, box: Callable[[], Box | None]
+    ) -> dict[str, str] | None:
+        """Return :func:`shape_declarations` ``(defs, style, ctx, box)``, from memory when it can."""
+        key = self._key(style, ctx)
+        if key is None:
+            return shape_declarations(defs, style, ctx, box)
+        decls = self._memo.get(key)
+        if decls is None:
+            decls = shape_declarations(defs, style, ctx, box)
+            if decls is None:  # cannot happen without clips or masks; never remembered
+                return None
+            if len(self._memo) >= MEMO_SIZE:
+                self._memo.clear()
+            self._memo[key] = decls
+        return dict(decls)
+
+    @staticmethod
+    def _key(style: dict[str, str], ctx: Ctx) -> tuple | None:
+        if ctx.context is not None or "clip-path" in style or "mask" in style:
+            return None
+        items = tuple(style.items())
+        if any("url(" in v or "context-" in v for _k, v in items):
+            return None
+        return items, scale_of(ctx.ctm), ctx.vp

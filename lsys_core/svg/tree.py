@@ -6,6 +6,7 @@ its siblings) in one pass, for CSS matching (``>``, ``+``, ``:first-child``) and
 
 from __future__ import annotations
 
+import functools
 import xml.etree.ElementTree as ET
 
 from lsys_core.quoting import quote_name
@@ -16,8 +17,12 @@ SVG_NS = "{http://www.w3.org/2000/svg}"
 XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
 
 
+@functools.lru_cache(maxsize=1024)
 def local_name(tag) -> str | None:
-    """Return the SVG local name of a tag, or None for comments, PIs and foreign namespaces."""
+    """Return the SVG local name of a tag, or None for comments, PIs and foreign namespaces.
+
+    Remembered per tag (a document has a few dozen): it is asked 8 times per element.
+    """
     if not isinstance(tag, str):
         return None
     if tag.startswith(SVG_NS):

@@ -21,7 +21,7 @@ from lsys_core.errors import LimitError
 from lsys_core.geometry.paths import ArrayPath
 from lsys_core.svg import group_effects, markers
 from lsys_core.svg.css import StyleSheet
-from lsys_core.svg.declare import shape_declarations
+from lsys_core.svg.declare import DeclarationMemo
 from lsys_core.svg.masking import Definitions
 from lsys_core.svg.paint import anisotropy
 from lsys_core.svg.pathcache import DEFAULT_MAX_SEGMENTS, PathCache
@@ -94,6 +94,7 @@ class Reader:
             self.tree, self.style_at, self.cascade.specified, self._clip_geometry, self.notes
         )
         self._style_cache: dict[int, dict[str, str]] = {}
+        self._declarations = DeclarationMemo()
         self._names = source_names(self.tree)
         self.order = 0
         self.root_font = DEFAULT_FONT_SIZE
@@ -312,7 +313,7 @@ class Reader:
         if empty and not self._markers_wanted(tag, style, geom):
             self.skips[reason or "degenerate (zero size)"] += 1
             return
-        decls = shape_declarations(self.resources, style, ctx, functools.cache(lambda: box_of(geom.path)))
+        decls = self._declarations.get(self.resources, style, ctx, functools.cache(lambda: box_of(geom.path)))
         if decls is None:
             return  # clipped out entirely
         stroked = decls.get("stroke", "none") != "none"
