@@ -92,18 +92,29 @@ def _chord_table(cubics: np.ndarray) -> np.ndarray:
     """Arc length of every eighth of every cubic, ``(K * T,)``, in blocks of bounded memory.
 
     A block of :data:`_CHUNK` cubics needs about 10 MB of temporaries; one path of 10^6
-    segments computed at once needed several GiB.
+    segments computed at once needed several GiB.  Straight segments (a line's cubic has its
+    control points at the thirds of its chord, so its speed is constant) get the exact eighth
+    of their chord without quadrature: a path of 10^6 lines spent 8 of 22 profiled seconds of
+    inference in this table.
     """
     knots = np.arange(_TABLE) / _TABLE
     out = np.empty((cubics.shape[0], _TABLE))
     for lo in range(0, cubics.shape[0], _CHUNK):
         c = cubics[lo : lo + _CHUNK]
-        k = c.shape[0]
-        out[lo : lo + k] = _partial_length(
-            np.broadcast_to(c[:, None, :], (k, _TABLE, 4)),
-            np.broadcast_to(knots, (k, _TABLE)),
-            np.broadcast_to(knots + 1.0 / _TABLE, (k, _TABLE)),
+        chord = c[:, 3] - c[:, 0]
+        tiny = 1e-12 * np.maximum(np.abs(c).max(axis=1), 1.0)
+        straight = (np.abs(3.0 * (c[:, 1] - c[:, 0]) - chord) <= tiny) & (
+            np.abs(3.0 * (c[:, 3] - c[:, 2]) - chord) <= tiny
         )
+        out[lo : lo + c.shape[0]][straight] = (np.abs(chord[straight]) / _TABLE)[:, None]
+        curved = np.flatnonzero(~straight)
+        if curved.size:
+            k = curved.size
+            out[lo + curved] = _partial_length(
+                np.broadcast_to(c[curved][:, None, :], (k, _TABLE, 4)),
+                np.broadcast_to(knots, (k, _TABLE)),
+                np.broadcast_to(knots + 1.0 / _TABLE, (k, _TABLE)),
+            )
     return out.ravel()
 
 

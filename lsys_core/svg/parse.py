@@ -127,6 +127,7 @@ def parse_svg(
         reader = Reader(tree, name, max_elements, max_depth)
         viewbox, size, ctx = _root_context(reader, root)
         reader.walk(root, ctx)
+        reader.paths.release()
         elements, skips = _elements(reader)
     finally:
         sys.setrecursionlimit(old_limit)
@@ -146,6 +147,7 @@ def parse_svg(
     verbatim = tuple(
         Verbatim(r.order, r.xml, r.what) for r in reader.records if isinstance(r, VerbatimRecord)
     )
+    reader.records.clear()  # their paths now live in the elements (the reader is in a cycle)
     return Scene(
         elements=tuple(elements),
         viewbox=viewbox,

@@ -45,6 +45,16 @@ class PathCache:
             arc_rows = np.cumsum(self._table.op == pd.ARC)
             self._arc_before = np.concatenate([[0], arc_rows])
 
+    def release(self) -> None:
+        """Forget the parsed paths (after the walk; the records keep the ones they drew).
+
+        The table and the converted paths of a path of 10^6 segments are 61 MiB each; the
+        reader that holds this cache lives in a reference cycle until the next collection.
+        """
+        self._index = {}
+        self._table = None
+        self._paths = []
+
     def get(self, d: str) -> tuple[ArrayPath, PathTable | None, str | None]:
         """Return the cubics, the rows and the first error of path data ``d``."""
         i = self._index.get(d)
