@@ -33,6 +33,9 @@ __all__ = ["LsysHighlighter", "RulesEditor", "RulesPanel"]
 
 #: Longest time the highlighter colours lines in one event-loop turn after a new text.
 HIGHLIGHT_BUDGET_MS = 8.0
+#: Characters of a line whose tokens are coloured: a 2,900-character start line coloured token
+#: by token took 25-30 ms to lay out at every change (3-8 ms with its tail plain).
+_TOKEN_COLOURS = 600
 #: Changed lines coloured at once when the text is replaced (more wait for later turns).
 _SYNC_LINES = 40
 #: Longest text whose changed lines are found line by line (:func:`_line_edits`).
@@ -120,8 +123,9 @@ class LsysHighlighter(QSyntaxHighlighter):
         plain = text
         for start, length in strings:  # path data holds hundreds of numbers: do not colour them
             plain = plain[:start] + " " * length + plain[start + length :]
+        tokens = plain[:_TOKEN_COLOURS]  # a long line's tail stays plain: see _TOKEN_COLOURS
         for rx, fmt in self._rules:
-            it = rx.globalMatch(plain)
+            it = rx.globalMatch(tokens)
             while it.hasNext():
                 m = it.next()
                 self.setFormat(m.capturedStart(), m.capturedLength(), fmt)

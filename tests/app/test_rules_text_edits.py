@@ -53,3 +53,14 @@ def test_any_sequence_of_texts_is_shown_exactly(qtbot, monkeypatch, diff_lines):
         text = "\n".join(lines)
         editor.replace_text(text)
         assert editor.toPlainText() == text
+
+
+def test_a_long_line_is_coloured_at_its_head_and_its_tail_stays_plain(qtbot):
+    editor = RulesEditor()
+    qtbot.addWidget(editor)
+    axiom = "axiom: " + " ".join(f"[ f({i}) P{i}(3) ]" for i in range(200))
+    editor.replace_text(f"lsys 1\n{axiom}\n")
+    qtbot.waitUntil(lambda: not editor.highlighter.pending, timeout=10_000)
+    ranges = editor.document().findBlockByNumber(1).layout().formats()
+    assert ranges, "the head of the line is coloured"
+    assert max(r.start + r.length for r in ranges) <= rules_panel._TOKEN_COLOURS < len(axiom)
