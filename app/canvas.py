@@ -131,7 +131,7 @@ class Canvas(CanvasNavigation, QWidget):
         else:
             rules = np.asarray(d.rule)
             if r is None:
-                self._highlight = np.asarray(d.symbol) == t
+                self._highlight = d.base_symbol() == t
             else:
                 self._highlight = np.isin(rules, r) if isinstance(r, (list, tuple, set)) else rules == r
 

@@ -80,7 +80,7 @@ def recolor(drawing: Any, mode: str) -> Any:
     if mode == "none" or drawing is None or len(drawing) == 0:
         return drawing
     styles, style = drawing.instance_styles()
-    key = np.asarray(drawing.symbol if mode == "group" else drawing.rule, np.int64)
+    key = np.asarray(drawing.base_symbol() if mode == "group" else drawing.rule, np.int64)
     color = group_color if mode == "group" else rule_color
     pairs, inverse = np.unique(np.stack([style, key], axis=1), axis=0, return_inverse=True)
     styled = tuple(_style_with_color(styles[s], color(k)) for s, k in pairs.tolist())

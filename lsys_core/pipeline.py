@@ -31,7 +31,16 @@ from lsys_core.instancing.merge import merge_within
 from lsys_core.instancing.model import Instancing, terminal_shapes
 from lsys_core.instancing.orientation import ring_headings, unwrap_symmetric
 from lsys_core.instancing.roundness import merge_round, round_within
-from lsys_core.report import InferenceResult, bounds, deviation, element_circles, measurer, reproduction_error
+from lsys_core.instancing.stretch import stretch_families
+from lsys_core.report import (
+    InferenceResult,
+    as_instancing,
+    bounds,
+    deviation,
+    element_circles,
+    measurer,
+    reproduction_error,
+)
 from lsys_core.settings import RELAXED, InferenceSettings
 from lsys_core.svg.model import Scene
 
@@ -97,7 +106,8 @@ def _instancing(scene: Scene, settings: InferenceSettings, tolerance: float, can
     inst = merge_within(scene, inst, tolerance)
     inst = regular_scales(scene, medoids(scene, inst, tolerance), tolerance)
     inst = round_within(terminal_shapes(inst), inst, tolerance)
-    return merge_round(scene.elements, terminal_shapes(inst), inst, tolerance)
+    inst = merge_round(scene.elements, terminal_shapes(inst), inst, tolerance)
+    return stretch_families(scene, inst, tolerance)
 
 
 def paint_like_input(grammar: Grammar, scene: Scene, inst: Instancing) -> Grammar:
@@ -111,8 +121,9 @@ def paint_like_input(grammar: Grammar, scene: Scene, inst: Instancing) -> Gramma
     orders = np.array([e.order if e.order >= 0 else i for i, e in enumerate(scene.elements)], float)
     drawing, trace = derive_traced(grammar, limit=max(10 * len(scene.elements), 1000))
     names = [inst.terminals[g].name for g in inst.group]
+    mapped = as_instancing(drawing, inst)  # stretched copies by the terminals of their elements
     match = match_instances(
-        [t.name for t in drawing.terminals], drawing.symbol, drawing.a, drawing.b, names, inst.a, inst.b
+        [t.name for t in mapped.terminals], mapped.symbol, mapped.a, mapped.b, names, inst.a, inst.b
     )
     if match is not None:
         grammar = fit_paint(grammar, [e.style for e in scene.elements], orders, match, trace, drawing)
@@ -213,6 +224,10 @@ def analyse(
     prec = Precision.of_box(*box, eps)
     inst = ring_headings(unwrap_symmetric(inst), eps)
     offsets = estimate_pivots(inst, sizes, tolerance=prec.eps)
+    if inst.stretch_base is not None:  # a stretch cuts its shape through the origin: keep it there
+        family = inst.stretch_base >= 0
+        family[inst.stretch_base[family]] = True
+        offsets = np.where(family, 0.0, offsets)
     inst = recenter(inst, offsets)
     sizes = sizes + np.abs(offsets)  # how far each shape reaches from its (moved) origin
     stages["pivots"] = time.perf_counter() - t
@@ -261,6 +276,9 @@ def rules_from_analysis(
     shape_dev = inst.deviation if inst.deviation is not None else np.zeros(inst.a.size)
     slack = np.maximum(limit - shape_dev, 0.0)
     measure = measurer(scene, inst)
+    # stretched copies are drawn as their base with a stretch: the grammar does not list them
+    copies = inst.stretch_base if inst.stretch_base is not None else np.full(len(inst.terminals), -1)
+    drawn = tuple(t for t, c in zip(inst.terminals, copies, strict=True) if c < 0)
     best: tuple[Grammar, Hierarchy, float, float, Drawing] | None = None
     for factor in _factors(settings, symmetrizing, len(scene.elements)):
         check(cancel)
@@ -286,10 +304,12 @@ def rules_from_analysis(
             progress=progress,
             timer=stages,
             cache=analysis.levels,
+            stretch_base=inst.stretch_base,
+            stretch=inst.stretch,
         )
         t = time.perf_counter()
-        grammar = simplify(Grammar(inst.terminals, tuple(hier.rules), hier.axiom, scene.viewbox, scene.size))
-        drawing = derive(grammar, limit=max(10 * len(scene.elements), 1000))
+        grammar = simplify(Grammar(drawn, tuple(hier.rules), hier.axiom, scene.viewbox, scene.size))
+        drawing = as_instancing(derive(grammar, limit=max(10 * len(scene.elements), 1000)), inst)
         error = deviation(inst, sizes, drawing, shape_dev, limit, measure)
         bits = grammar_bits(grammar, prec)
         stages["postprocess"] = stages.get("postprocess", 0.0) + time.perf_counter() - t

@@ -20,7 +20,15 @@ from lsys_core.grammar.model import Grammar
 from lsys_core.instancing.model import Instancing
 from lsys_core.svg.model import Scene
 
-__all__ = ["InferenceResult", "bounds", "deviation", "element_circles", "measurer", "reproduction_error"]
+__all__ = [
+    "InferenceResult",
+    "as_instancing",
+    "bounds",
+    "deviation",
+    "element_circles",
+    "measurer",
+    "reproduction_error",
+]
 
 
 def element_circles(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
@@ -39,6 +47,33 @@ def bounds(scene: Scene) -> tuple[complex, complex]:
     """Corners of the bounding box of all control points (it holds every outline)."""
     pts = np.concatenate([e.cubics.reshape(-1) for e in scene.elements])
     return complex(pts.real.min(), pts.imag.min()), complex(pts.real.max(), pts.imag.max())
+
+
+def as_instancing(drawing, inst: Instancing):
+    """Return ``drawing`` with its instances numbered by the terminals of ``inst``.
+
+    A grammar's terminals are the instancing's, but for stretched copies
+    (:mod:`lsys_core.instancing.stretch`), which the grammar draws as their base with a stretch:
+    every instance is given the terminal of ``inst`` its terminal's name and its stretch draw
+    (the nearest stretch of that base), so it can be matched with the input elements.
+    """
+    from dataclasses import replace
+
+    index = {t.name: g for g, t in enumerate(inst.terminals)}
+    sym = np.asarray(drawing.symbol, np.int64)
+    if drawing.bases:
+        sym = np.asarray(drawing.bases, np.int64)[sym]
+    names = np.array([index.get(t.name, -1) for t in drawing.terminals] + [-1], np.int64)
+    out = names[np.where((sym >= 0) & (sym < len(drawing.terminals)), sym, len(drawing.terminals))]
+    if inst.stretch_base is not None and inst.stretch is not None:
+        stretch = np.zeros(sym.size) if drawing.stretch is None else np.asarray(drawing.stretch, float)
+        for g in np.unique(inst.stretch_base[inst.stretch_base >= 0]):
+            choices = np.concatenate([[g], np.flatnonzero(inst.stretch_base == g)])
+            amounts = np.concatenate([[0.0], inst.stretch[choices[1:]]])
+            mine = np.flatnonzero(out == g)
+            pick = np.argmin(np.abs(stretch[mine, None] - amounts[None, :]), axis=1)
+            out[mine] = choices[pick]
+    return replace(drawing, terminals=inst.terminals, symbol=out.astype(np.int32), stretch=None, bases=())
 
 
 def _matched(inst: Instancing, sizes: np.ndarray, drawing) -> tuple[np.ndarray, np.ndarray] | None:

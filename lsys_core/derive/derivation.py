@@ -30,6 +30,7 @@ from lsys_core.derive.jitter import jitter_instances
 from lsys_core.derive.model import Calls, Drawing
 from lsys_core.derive.order import Items, string_positions
 from lsys_core.derive.paint import paint_z, resolve_styles
+from lsys_core.derive.stretched import stretched
 from lsys_core.derive.turtle import Interpreter, case_masks, chain_frames, segmented_exclusive_cumsum
 from lsys_core.errors import LimitError
 from lsys_core.grammar.model import COND_EQ0, COND_GT0, Grammar, Randomize
@@ -88,7 +89,7 @@ class _Emitter:
                 np.full(n, term, np.int32),
                 a,
                 b,
-                np.broadcast_to(np.asarray(z, float), (n,)),
+                np.broadcast_to(np.asarray(z, complex), (n,)),
                 np.full(n, rule, np.int32),
                 np.broadcast_to(np.asarray(m, np.int64), (n,)),
                 np.full(n, slot, np.int64),
@@ -193,7 +194,7 @@ class _Derivation:
             return
         parent = np.broadcast_to(np.asarray(parent, np.int64), m.shape)
         rank = np.broadcast_to(np.asarray(rank, np.int64), m.shape)
-        z = np.broadcast_to(np.asarray(z, float), m.shape)
+        z = np.broadcast_to(np.asarray(z, complex), m.shape)
         if self.grammar.rules[target].parametric:
             keep = m >= 0
             if not keep.all():
@@ -335,7 +336,7 @@ class _Derivation:
         has = lengths > 0
         end_a = np.where(has, a, 0j)
         end_b = np.where(has, b, 0j)
-        end_z = np.where(has, z, 0.0)
+        end_z = np.where(has, z, 0j)
         if has.any():
             li = last[has]
             end_a[has] = step_a[li] * a_net[li]
@@ -367,18 +368,20 @@ class _Derivation:
         if parts:
             cols = [np.concatenate([p[k] for p in parts]) for k in range(10)]
         else:
-            cols = [np.zeros(0, t) for t in (np.int32, complex, complex, float, np.int32)]
+            cols = [np.zeros(0, t) for t in (np.int32, complex, complex, complex, np.int32)]
             cols += [np.zeros(0, t) for t in (np.int64, np.int64, np.int32, np.int64, np.int64)]
         sym, a, b, z, rule, m, slot, paint, parent, rank = cols
         pos = string_positions(self.items, parent, rank)
-        z = z.astype(float) + paint_z(self.program.paints, paint, m)
+        z = np.asarray(z, complex)
+        stretch = z.imag.copy()
+        z = z.real + paint_z(self.program.paints, paint, m)
         if g.order:
             table = np.asarray(g.order, float)
             listed = pos < table.size
             z[listed] += table[pos[listed]]
         order = np.lexsort((pos, z))
-        sym, a, b, z, rule, m, slot, paint, pos = (
-            x[order] for x in (sym, a, b, z, rule, m, slot, paint, pos)
+        sym, a, b, z, rule, m, slot, paint, pos, stretch = (
+            x[order] for x in (sym, a, b, z, rule, m, slot, paint, pos, stretch)
         )
         styles, style = resolve_styles(g, self.program.paints, sym, paint, m, pos)
         calls = self.calls(parent[order])
@@ -396,4 +399,5 @@ class _Derivation:
             verbatim=g.verbatim,
             calls=calls,
         )
+        drawing = stretched(drawing, stretch)
         return drawing, Trace(pos, slot, m, z, tuple(self.program.slots))

@@ -99,6 +99,8 @@ def _step(g: Grammar, card: Card) -> tuple[complex, complex] | None:
     for mod in reversed(body[:-1]):  # the run of turtle moves just before the tail call
         if not isinstance(mod, Turtle):
             break
+        if mod.op in ("z", "~"):
+            continue  # paint order and stretch do not move the turtle
         if mod.value.cd or mod.value.table:
             return None
         run.append(mod)

@@ -69,6 +69,13 @@ class Drawing:
         Content drawn as is; ``order`` is the number of instances drawn before it.
     calls : Calls or None
         The rule calls the instances come from (None: not known, e.g. a drawing built by hand).
+    stretch : ndarray of float, shape (n,), or None
+        The stretch every instance was drawn with (``~(t)``, in its terminal's units; None: no
+        instance is stretched).  A stretched instance's ``symbol`` is a terminal of its own,
+        appended after the grammar's, whose path is the stretched shape (see ``bases``).
+    bases : tuple of int
+        For every terminal, the grammar terminal it is a stretched copy of (empty: each terminal
+        is its own).
 
     Stroke widths and dashes in the styles are in canvas units, except for terminals whose
     ``scaled`` flag is set (they scale with the instance, see :meth:`stroke_scale`).
@@ -86,9 +93,18 @@ class Drawing:
     defs: str = ""
     verbatim: tuple[Verbatim, ...] = ()
     calls: Calls | None = None
+    stretch: np.ndarray | None = None
+    bases: tuple[int, ...] = ()
 
     def __len__(self) -> int:
         return int(self.symbol.size)
+
+    def base_symbol(self) -> np.ndarray:
+        """Return every instance's grammar terminal: its own, or the one its stretched shape comes from."""
+        sym = np.asarray(self.symbol, np.int64)
+        if not self.bases:
+            return sym
+        return np.asarray(self.bases, np.int64)[sym]
 
     def instance_styles(self) -> tuple[tuple[str, ...], np.ndarray]:
         """Return the distinct styles and each instance's index into them."""

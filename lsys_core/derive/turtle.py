@@ -1,7 +1,10 @@
 """The vectorised turtle of the derivation: case selection, interpretation of compiled bodies, chained frames.
 
 All functions work on a batch of pending calls at once (numpy arrays of counters ``m`` and
-turtle states ``(a, b, z)``); :mod:`.derivation` drives them level by level.
+turtle states ``(a, b, z)``); :mod:`.derivation` drives them level by level.  The turtle's two
+additive numbers travel together as one complex ``z``: its real part is the paint-order value
+(``z(Δ)``), its imaginary part the stretch (``~(t)``); both are saved by ``[``, restored by
+``]`` and summed along a sequence in the same way.
 """
 
 from __future__ import annotations
@@ -49,10 +52,10 @@ class Interpreter:
         n = m.size
         a = np.ones(n, complex) if a is None else a
         b = np.zeros(n, complex) if b is None else b
-        z = np.zeros(n) if z is None else z
+        z = np.zeros(n, complex) if z is None else z
         rand = self.rand if perturb else None
         if n == 1 and rand is None:
-            return _run_one(ops, int(m[0]), complex(a[0]), complex(b[0]), float(z[0]))
+            return _run_one(ops, int(m[0]), complex(a[0]), complex(b[0]), complex(z[0]))
         stack = []
         draws = []
         calls = []
@@ -74,6 +77,8 @@ class Interpreter:
                     a = a * v
                 elif sym == "z":
                     z = z + v
+                elif sym == "~":
+                    z = z + 1j * v
                 else:
                     ang = v if sym == "+" else -v
                     if rand is not None and rand.angle:
@@ -91,7 +96,7 @@ class Interpreter:
         return a, b, z, draws, calls
 
 
-def _run_one(ops, m: int, a: complex, b: complex, z: float):
+def _run_one(ops, m: int, a: complex, b: complex, z: complex):
     """:meth:`Interpreter.run` for one item without perturbation, in Python scalars.
 
     A body run for one item (the axiom, a rule called once: typically the rule that places
@@ -101,8 +106,8 @@ def _run_one(ops, m: int, a: complex, b: complex, z: float):
     """
     stack = []
     at: list[tuple[int, tuple]] = []  # (op index, op) of every draw
-    states: list[tuple[complex, complex, float]] = []
-    raw_calls: list[tuple[int, int, int, complex, complex, float]] = []
+    states: list[tuple[complex, complex, complex]] = []
+    raw_calls: list[tuple[int, int, int, complex, complex, complex]] = []
     for i, op in enumerate(ops):
         kind = op[0]
         if kind == "t":
@@ -114,6 +119,8 @@ def _run_one(ops, m: int, a: complex, b: complex, z: float):
                 a = a * v
             elif sym == "z":
                 z = z + v
+            elif sym == "~":
+                z = z + 1j * v
             else:
                 a = a * _turn(DEG * (v if sym == "+" else -v))
         elif kind == "[":
@@ -128,7 +135,7 @@ def _run_one(ops, m: int, a: complex, b: complex, z: float):
             raw_calls.append((i, target, k0 + k1 * m, a, b, z))
     sa = np.array([s[0] for s in states], complex)
     sb = np.array([s[1] for s in states], complex)
-    sz = np.array([s[2] for s in states], float)
+    sz = np.array([s[2] for s in states], complex)
     draws = [(i, op, sa[j : j + 1], sb[j : j + 1], sz[j : j + 1]) for j, (i, op) in enumerate(at)]
     calls = [
         (i, t, np.array([mm], np.int64), np.array([ca]), np.array([cb]), np.array([cz]))

@@ -25,7 +25,7 @@ _TOKEN = re.compile(
     | (?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)
     | (?P<name>[A-Za-z_][A-Za-z0-9_]*)
     | (?P<arrow>->|→)
-    | (?P<punct>==|[-−+*∗()\[\]:>{},])
+    | (?P<punct>==|[-−+*∗()\[\]:>{},~])
     | (?P<eps>ε)
     """,
     re.VERBOSE,

@@ -2,10 +2,19 @@
 
 Modules
 -------
-``f(Δ)``, ``+(δ)``, ``-(δ)``, ``*(s)``, ``z(Δ)``
+``f(Δ)``, ``+(δ)``, ``-(δ)``, ``*(s)``, ``z(Δ)``, ``~(t)``
     :class:`Turtle` commands; their value is linear in the rule's counter ``m``:
     ``t(m) = t0 + tΔ·m`` (:class:`Linear`).  ``z`` moves the turtle in paint order (later
-    terminals with a larger ``z`` are drawn on top).
+    terminals with a larger ``z`` are drawn on top).  ``~`` adds to the turtle's *stretch*
+    (format version 4): a terminal drawn with stretch ``t`` is cut along its local x axis
+    (the line ``y = 0`` through its origin) and its two halves pulled apart by ``t``: every
+    point with ``y > 0`` moves by ``+t/2`` along the local y axis, every point with ``y < 0``
+    by ``-t/2`` (a piecewise translation, not a scale, so rounded corners and stroke widths
+    stay as they are; exact for shapes whose segments crossing the cut are straight).  The
+    stretch is in the terminal's own units, is saved by ``[`` and restored by ``]`` like the
+    rest of the turtle state, starts at 0 and is summed like ``z``: a bar chart's bars of one
+    width are one terminal, ``P(m) -> [ ~([16, 40, 8]) A ] f(22) P(m-1)``, and bars that grow
+    by 16 per step are ``P(m): m > 0 -> A ~(16) f(22) P(m-1)``.
 ``[`` ``]``
     :class:`Push` / :class:`Pop` of the turtle state.
 ``A``, ``P(m-1)``, ``Q(3)``
@@ -52,7 +61,7 @@ COND_EQ0: Final = "m == 0"
 #: The condition of a case of a parametric rule.
 CaseCondition = Literal["m > 0", "m == 0"]
 Condition = CaseCondition | None
-TurtleOp = Literal["f", "+", "-", "*", "z"]
+TurtleOp = Literal["f", "+", "-", "*", "z", "~"]
 Jitter = Literal["cumulative", "instance"]
 JITTERS: tuple[Jitter, ...] = ("cumulative", "instance")
 
@@ -99,7 +108,7 @@ class Count:
 
 @dataclass(frozen=True)
 class Turtle:
-    """A turtle command ``f``, ``+``, ``-``, ``*`` or ``z`` with a value linear in ``m``."""
+    """A turtle command ``f``, ``+``, ``-``, ``*``, ``z`` or ``~`` with a value linear in ``m``."""
 
     op: TurtleOp
     value: Linear

@@ -35,7 +35,9 @@ __all__ = ["KINDS", "Param", "list_params", "set_param", "set_params"]
 KINDS = ("angle", "distance", "scale", "angle_delta", "distance_delta", "scale_delta", "count")
 """Every :attr:`Param.kind`."""
 
-_KIND_OF_OP = {"f": "distance", "+": "angle", "-": "angle", "*": "scale"}
+#: How a parameter's label names its command when the operator alone would not say it.
+_WORD_OF_OP = {"~": "stretch"}
+_KIND_OF_OP = {"f": "distance", "+": "angle", "-": "angle", "*": "scale", "~": "distance"}
 
 
 @dataclass(frozen=True)
@@ -91,7 +93,7 @@ def list_params(g: Grammar) -> list[Param]:
                 continue  # paint order, not geometry: not a slider (set_param still takes its key)
             if isinstance(mod, Turtle):
                 nth[mod.op] += 1
-                label = f"{prefix}: {mod.op} #{nth[mod.op]}"
+                label = f"{prefix}: {_WORD_OF_OP.get(mod.op, mod.op)} #{nth[mod.op]}"
                 kind = _KIND_OF_OP[mod.op]
                 if mod.value.table:
                     out += [

@@ -28,7 +28,7 @@ __all__ = ["NON_FINITE", "SEED_LIMIT", "LineReader"]
 NON_FINITE = frozenset({"nan", "inf", "infinity"})
 #: Seeds are stored as written; beyond this they would not survive a round trip through floats.
 SEED_LIMIT = 2**53
-_TURTLE_OPS: dict[str, TurtleOp] = {"f": "f", "+": "+", "-": "-", "*": "*", "z": "z"}
+_TURTLE_OPS: dict[str, TurtleOp] = {"f": "f", "+": "+", "-": "-", "*": "*", "z": "z", "~": "~"}
 
 
 class LineReader:
@@ -46,6 +46,8 @@ class LineReader:
         self.turtle_ops = turtle_ops
         #: Whether the file's version has table values ``[v0, v1, ...]`` (version 3).
         self.tables = True
+        #: Whether the file's version has the stretch command ``~(t)`` (version 4).
+        self.stretch = True
 
     def peek(self) -> Tok:
         """Return the current token without consuming it."""
@@ -127,6 +129,8 @@ class LineReader:
                     mods.append(Pop())
                 self.take()
             elif self._turtle_at(tok):
+                if tok.text == "~" and not self.stretch:
+                    raise fail("a stretch ~(...) needs format version 4: write 'lsys 4' as the header", tok)
                 self.take()
                 self.expect("(", f"'(' after '{tok.text}'")
                 self.places[(where, owner, ci, len(mods), True)] = self.peek().pos
@@ -148,7 +152,7 @@ class LineReader:
     def _turtle_at(self, tok: Tok) -> bool:
         """Tell whether ``tok`` starts a turtle command of this version."""
         if tok.kind == "punct":
-            return tok.text in "+-*"
+            return tok.text in "+-*~"
         return tok.kind == "name" and tok.text in ("f", "z") and tok.text in self.turtle_ops
 
     def symbol(self, tok: Tok, place: tuple, no_m: str | None) -> Symbol:

@@ -83,8 +83,8 @@ def runs(owner: str, ci: int, body: tuple[Module, ...]) -> Iterator[tuple[int, l
     """Yield ``(index after the run, ops)`` for every run of consecutive turtle commands."""
     run: list[Op] = []
     for i, mod in enumerate(body):
-        if isinstance(mod, Turtle) and mod.op == "z":
-            continue  # paint order moves no geometry: the run goes on
+        if isinstance(mod, Turtle) and mod.op in ("z", "~"):
+            continue  # paint order and stretch move no pose: the run goes on
         if isinstance(mod, Turtle) and not mod.value.table:  # a table value ends a run, as a symbol does
             run.append(Op(f"{owner}.{ci}.{i}.v", mod.op, float(mod.value.c0), float(mod.value.cd)))
             continue

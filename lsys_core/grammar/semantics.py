@@ -18,7 +18,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 
-from lsys_core.grammar.model import COND_EQ0, Grammar, Module, Rule, Symbol, Turtle
+from lsys_core.grammar.model import COND_EQ0, Grammar, Module, Pop, Push, Rule, Symbol, Turtle
 from lsys_core.grammar.runs import Control, Op, Write, merge, runs, sequence_words, signature, step_controls
 
 __all__ = ["Card", "Control", "Write", "describe", "describe_iter", "rule_closures", "rules_under"]
@@ -119,6 +119,7 @@ def _card(g: Grammar, rule: Rule, sites: list[tuple[str, int]]) -> Card:
         for end, run in runs(rule.name, ci, case.body):
             is_step = signature(run) == step_sig
             controls += step_controls(run, "step " if is_step else _place_prefix(end, case.body, seen))
+    controls += _stretch_controls(rule)
     controls = merge(controls)
     counts = sorted({k0 for _, k0 in sites})
     if rule.parametric and self_calls >= 2:
@@ -142,6 +143,33 @@ def _card(g: Grammar, rule: Rule, sites: list[tuple[str, int]]) -> Card:
         summary += f", {'a table' if tables == 1 else f'{tables} tables'} of values"
     count = int(reps) if reps is not None else None
     return Card(rule.name, kind, summary, terminals, calls, tuple(count_controls + controls), count)
+
+
+def _stretch_controls(rule: Rule) -> list[Control]:
+    """Controls of the stretch commands ``~(t)`` of a rule: "stretch per step" in a sequence's step."""
+    out: list[Control] = []
+    for ci, case in enumerate(rule.cases):
+        depth = 0
+        for i, mod in enumerate(case.body):
+            depth += 1 if isinstance(mod, Push) else -1 if isinstance(mod, Pop) else 0
+            if not (isinstance(mod, Turtle) and mod.op == "~") or mod.value.table:
+                continue
+            step = rule.parametric and depth == 0 and any(_is_self(m, rule) for m in case.body[i:])
+            label = "stretch per step" if step else "stretch"
+            key = f"{rule.name}.{ci}.{i}"
+            out.append(Control("stretch", label, float(mod.value.c0), "distance", "", (Write(f"{key}.v"),)))
+            if mod.value.cd:
+                out.append(
+                    Control(
+                        "stretch change",
+                        f"{label} change with m",
+                        float(mod.value.cd),
+                        "distance_delta",
+                        "",
+                        (Write(f"{key}.dv"),),
+                    )
+                )
+    return out
 
 
 def _is_self(mod: Module, rule: Rule) -> bool:

@@ -93,6 +93,7 @@ class _Line(LineReader):
         super().__init__(toks, RESERVED_V1 if v1 else RESERVED, state.places, "f" if v1 else "fz")
         self.st = state
         self.tables = state.version >= 3
+        self.stretch = state.version >= 4
         self.keywords = KEYWORDS_V1 if v1 else KEYWORDS
 
     def header(self) -> None:
@@ -111,6 +112,7 @@ class _Line(LineReader):
             )
         self.st.version = int(self.take().text)
         self.tables = self.st.version >= 3
+        self.stretch = self.st.version >= 4
         self.end()
 
     def statement(self) -> None:

@@ -337,7 +337,7 @@ def _body_problems(
 
 def _turtle_problem(mod: Turtle, parametric: bool, no_m: str) -> str | None:
     """Return what is wrong with a turtle module, or None."""
-    if mod.op not in ("f", "+", "-", "*", "z"):
+    if mod.op not in ("f", "+", "-", "*", "z", "~"):
         return f"unknown turtle command {mod.op!r}"
     v = mod.value
     if not isinstance(v, Linear) or not (_finite(v.c0) and _finite(v.cd)):

@@ -8,8 +8,8 @@ from lsys_core.grammar.validate import count_text
 
 __all__ = ["FORMAT_VERSION", "format_grammar", "format_number", "format_version"]
 
-FORMAT_VERSION = 3
-"""The newest format version (versions 1 and 2 are read too).  A grammar is written in the oldest
+FORMAT_VERSION = 4
+"""The newest format version (versions 1 to 3 are read too).  A grammar is written in the oldest
 version that expresses it: see :func:`format_version`."""
 
 #: Table items per line of a ``paint:`` or ``order:`` statement (a continued statement repeats its keyword).
@@ -78,9 +78,12 @@ def format_version(g: Grammar) -> int:
     version 2 added: named styles, occurrence paints, ``z``, the ``paint:``/``order:`` tables,
     ``defs``, ``verbatim`` content and the ``randomize`` line.  So a version-1 file stays
     readable by version-1 readers after it is edited and saved.  Version 3 added table values
-    ``[v0, v1, ...]``; a grammar without them is written in version 2 or 1.
+    ``[v0, v1, ...]``; a grammar without them is written in version 2 or 1.  Version 4 added
+    the stretch command ``~(t)``.
     """
     bodies = [g.axiom] + [c.body for r in g.rules for c in r.cases]
+    if any(isinstance(m, Turtle) and m.op == "~" for body in bodies for m in body):
+        return 4
     if any(isinstance(m, Turtle) and m.value.table for body in bodies for m in body):
         return 3
     v2 = (

@@ -33,7 +33,7 @@ __all__ = ["compose", "flat_bits", "grammar_bits", "rule_bits", "run_bits", "str
 
 def _turtle_bits(prec: Precision, t: Turtle) -> float:
     def number(v: float) -> float:
-        if t.op == "f":
+        if t.op in ("f", "~"):
             return prec.length_bits
         return prec.scale_bits() if t.op == "*" else angle_value_bits(prec, v)
 
@@ -51,13 +51,16 @@ def run_bits(prec: Precision, turtles: list[Turtle]) -> float:
     frame = compose(turtles)
     if frame is None:
         return sum(_turtle_bits(prec, t) for t in turtles)
-    return transform_bits(prec, *frame)
+    extra = sum(_turtle_bits(prec, t) for t in turtles if t.op in ("z", "~"))
+    return transform_bits(prec, *frame) + extra
 
 
 def compose(turtles: list[Turtle]) -> tuple[complex, complex] | None:
     """The relative frame ``(A, B)`` of constant turtle commands (None if one depends on ``m``)."""
     a, b = 1 + 0j, 0j
     for t in turtles:
+        if t.op in ("z", "~"):
+            continue  # paint order and stretch do not move the turtle
         if t.value.cd != 0 or t.value.table:
             return None
         v = t.value.c0

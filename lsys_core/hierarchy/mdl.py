@@ -280,7 +280,7 @@ def table_bits(prec: Precision, values, op: str, lever: float | None = None) -> 
     reach = prec.diagonal if lever is None else float(lever)
     if op == "*":
         v, first = np.log(np.maximum(v, 1e-300)) * reach, prec.scale_bits(reach)
-    elif op == "f":
+    elif op in ("f", "~"):
         first = prec.length_bits
     else:
         v, first = np.radians(v) * prec.diagonal, prec.angle_bits()

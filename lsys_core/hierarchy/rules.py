@@ -121,6 +121,8 @@ def build_hierarchy(
     progress: Progress | None = None,
     timer: dict[str, float] | None = None,
     cache: LevelCache | None = None,
+    stretch_base: np.ndarray | None = None,
+    stretch: np.ndarray | None = None,
 ) -> Hierarchy:
     """Generate rules level by level until one node is left (§5.5–§5.6).
 
@@ -160,6 +162,11 @@ def build_hierarchy(
     cache
         If given, every level's candidates are looked up in it first and stored in it
         (they do not depend on ``weights``: re-weighting reuses them).
+    stretch_base, stretch
+        Per terminal, the terminal it is a stretched copy of (-1: none) and the stretch
+        (:mod:`lsys_core.instancing.stretch`): such a terminal is written as its base drawn with
+        ``~(t)``, and rows of one base at several stretches are found with the partly regular
+        repetitions (:mod:`.tabulated`).
 
     Returns
     -------
@@ -169,6 +176,8 @@ def build_hierarchy(
     nt = len(terminal_names)
     sim = similarity if similarity is not None else np.full((nt, nt), 0.5) + 0.5 * np.eye(nt)
     table = SymbolTable(terminal_names, terminal_sizes, sim)
+    if stretch_base is not None and stretch is not None:
+        table.set_stretch(stretch_base, stretch)
     ctx = _Context(table, tol)
     book = _Book()
     prec = precision

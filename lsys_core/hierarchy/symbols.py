@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lsys_core.grammar.model import Count, Module, Pop, Push, Symbol
+from lsys_core.grammar.model import Count, Linear, Module, Pop, Push, Symbol, Turtle
 
 __all__ = ["SymbolInfo", "SymbolTable"]
 
@@ -48,6 +48,27 @@ class SymbolTable:
         self._counters = {"P": 0, "R": 0, "X": 0, "Z": 0}
         self.similarity = similarity
         self.n_terminals = len(terminal_names)
+        #: Per terminal, the terminal it is a stretched copy of (itself if none), and the stretch.
+        self.stretch_base = np.arange(self.n_terminals)
+        self.stretch = np.zeros(self.n_terminals)
+
+    def set_stretch(self, base: np.ndarray, amount: np.ndarray) -> None:
+        """Record which terminals are stretched copies of which (``base`` -1: none), and by how much."""
+        base = np.asarray(base, np.int64)
+        self.stretch_base = np.where(base >= 0, base, np.arange(self.n_terminals))
+        self.stretch = np.where(base >= 0, np.asarray(amount, float), 0.0)
+
+    def stretch_family(self, sids: np.ndarray) -> np.ndarray:
+        """The symbol every symbol of ``sids`` is drawn from: a stretched copy's base, else itself."""
+        sids = np.asarray(sids, np.int64)
+        inside = sids < self.n_terminals
+        return np.where(inside, self.stretch_base[np.where(inside, sids, 0)], sids)
+
+    def stretch_of(self, sids: np.ndarray) -> np.ndarray:
+        """The stretch every symbol of ``sids`` is drawn with (0 but for stretched copies)."""
+        sids = np.asarray(sids, np.int64)
+        inside = sids < self.n_terminals
+        return np.where(inside, self.stretch[np.where(inside, sids, 0)], 0.0)
 
     def __len__(self) -> int:
         return len(self.infos)
@@ -96,6 +117,10 @@ class SymbolTable:
     def draw(self, sid: int, last: bool = False) -> tuple[Module, ...]:
         """Modules that draw symbol ``sid`` without moving the turtle (brackets for non-terminals)."""
         mod = self.ref(sid)
+        if sid < self.n_terminals and self.stretch_base[sid] != sid:
+            t = float(self.stretch[sid])
+            drawn = (Turtle("~", Linear(t)), self.ref(int(self.stretch_base[sid])))
+            return drawn if last else (Push(), *drawn, Pop())
         return (mod,) if last or self.infos[sid].terminal else (Push(), mod, Pop())
 
     def phi(self, si: int, sj: int) -> float:

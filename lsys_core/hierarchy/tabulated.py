@@ -8,7 +8,11 @@ all but one number:
   progression (the rings of a wheel, a target), coded ``P(m) -> [ *([s…]) A ] P(m-1)``;
 * *rows at data positions*: copies evenly spaced along an axis (rows of a dot plot, bars of a
   chart) but each moved across it by its own amount, coded
-  ``P(m) -> [ +(φ) f([o…]) +(-φ) A ] +(ψ) f(d) +(-ψ) P(m-1)``.
+  ``P(m) -> [ +(φ) f([o…]) +(-φ) A ] +(ψ) f(d) +(-ψ) P(m-1)``; the copies may be stretched
+  copies of one shape (:mod:`lsys_core.instancing.stretch`: the bars of a bar chart, of one
+  width and free heights), each drawn with its stretch, ``[ +(φ) f([o…]) +(-φ) ~([t…]) A ]``.
+  In such a row, offsets and stretches that change by one amount per step (bars growing by
+  16, their centres rising by 8) are written linear in ``m`` instead of as tables.
 
 The free number is written as a table value (``[v0, v1, …]``, entry ``m``), the rest as one
 rule.  These are looked for among the nodes that no exact repetition explained, just before the
@@ -26,10 +30,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from lsys_core.grammar.model import Case, Count, Linear, Module, Pop, Push, Rule, Symbol, Turtle
-from lsys_core.hierarchy.describe import rule_bits
+from lsys_core.hierarchy.describe import rule_bits, run_bits
 from lsys_core.hierarchy.emit import ANGLE_SNAP, const_t, nice, nice_array
 from lsys_core.hierarchy.mdl import (
     KIND_BITS,
+    OP_BITS,
     Precision,
     angle_value_bits,
     count_bits,
@@ -52,6 +57,9 @@ MIN_COPIES = 3
 #: then states in the rules what the set code says implicitly.  (Copies at random places never
 #: share a centre, so this cannot turn chance into rules.)
 RULE_BITS = 32.0
+#: Share of its nodes' slack a row of stretched copies may spend writing an offset or a stretch
+#: that grows by one amount per step as a value linear in ``m`` instead of a table.
+LINEAR_SHARE = 0.25
 #: Axes rows are looked for along: the canvas's (charts and designers' grids are aligned to them).
 AXES = (1 + 0j, 1j)
 
@@ -75,6 +83,8 @@ class Tabulated:
         The free number of every copy, one row per step of the rule in drawing order: its
         scale relative to the first copy (one column), or its offset across the axis from the
         first copy (document units; one column per copy at each level of the row).
+    stretch : ndarray of float, optional
+        For a row of stretched copies of ``sym``, every copy's stretch (shaped like ``values``).
     """
 
     sym: int
@@ -83,6 +93,7 @@ class Tabulated:
     axis: complex
     step: float
     values: np.ndarray
+    stretch: np.ndarray | None = None
 
     @property
     def steps(self) -> int:
@@ -172,26 +183,37 @@ def _level_runs(along: np.ndarray, q: float) -> list[tuple[np.ndarray, int, floa
     return runs
 
 
-def _rows(sym: int, idx: np.ndarray, nodes: Nodes, size: float, period: float) -> list[Tabulated]:
-    """Rows along a canvas axis: evenly spaced levels with as many copies each, moved across freely."""
+def _rows(
+    sym: int, idx: np.ndarray, nodes: Nodes, size: float, period: float, stretch: np.ndarray | None = None
+) -> list[Tabulated]:
+    """Rows along a canvas axis: evenly spaced levels with as many copies each, moved across freely.
+
+    ``stretch`` (per node, None: none) is the stretch every node is drawn with.
+    """
     out: list[Tabulated] = []
     q = max(float(np.min(nodes.slack[idx])), 1e-12)
     first = nodes.first_members()
     for group in _pose_groups(idx, nodes, size, period, q):
         free = np.ones(group.size, bool)
-        for axis in AXES:
+        while np.count_nonzero(free) >= MIN_COPIES:  # the longest row first, along either axis
             members = group[free]
-            if members.size < MIN_COPIES:
+            best = None
+            for axis in AXES:
+                along = (nodes.b[members] / axis).real
+                order = np.lexsort((first[members], along))
+                for at, k, step in _level_runs(along[order], q):
+                    if best is None or at.size > best[1].size:
+                        best = (axis, members[order[at]], k, step)
+            if best is None:
                 break
-            along = (nodes.b[members] / axis).real
-            order = np.lexsort((first[members], along))
-            for at, k, step in _level_runs(along[order], q):
-                # level by level, each level's copies in document order
-                run = members[order[at]].reshape(-1, k)
-                run = np.take_along_axis(run, np.argsort(first[run], axis=1, kind="stable"), axis=1)
-                across = (nodes.b[run] / axis).imag
-                out.append(Tabulated(sym, run.ravel(), "offset", axis, step, across - across[0, 0]))
-                free[np.isin(group, run)] = False
+            axis, run, k, step = best
+            # level by level, each level's copies in document order
+            run = run.reshape(-1, k)
+            run = np.take_along_axis(run, np.argsort(first[run], axis=1, kind="stable"), axis=1)
+            across = (nodes.b[run] / axis).imag
+            st = None if stretch is None else stretch[run]
+            out.append(Tabulated(sym, run.ravel(), "offset", axis, step, across - across[0, 0], st))
+            free[np.isin(group, run)] = False
     return out
 
 
@@ -211,17 +233,27 @@ def find_tabulated(table: SymbolTable, nodes: Nodes, period: np.ndarray) -> list
     sizes = table.sizes
     found: list[Tabulated] = []
     taken = np.zeros(len(nodes), bool)
-    for sym in np.unique(nodes.sym):
-        idx = np.flatnonzero(nodes.sym == sym)
+    family = table.stretch_family(nodes.sym)
+    drawn = table.stretch_of(nodes.sym)
+    for key in np.unique(family):
+        idx = np.flatnonzero(family == key)
         if idx.size < MIN_COPIES:
             continue
         idx = idx[np.argsort(first[idx], kind="stable")]
-        size, per = float(sizes[sym]), float(period[sym]) if sym < period.size else 0.0
+        size = float(np.max(sizes[np.unique(nodes.sym[idx])]))
+        per = float(period[key]) if key < period.size else 0.0
+        stretched = bool(np.any(drawn[idx] != 0))
         for find in (_concentric, _rows):
             free = idx[~taken[idx]]
             if free.size < MIN_COPIES:
                 break
-            for t in find(int(sym), free, nodes, size, per):
+            if find is _concentric:
+                if stretched:
+                    continue  # concentric copies at one stretch each: not looked for
+                parts = find(int(key), free, nodes, size, per)
+            else:
+                parts = _rows(int(key), free, nodes, size, per, drawn if stretched else None)
+            for t in parts:
                 found.append(t)
                 taken[t.nodes] = True
     return found
@@ -239,15 +271,36 @@ def tabulated_rule(table: SymbolTable, t: Tabulated, name: str, nodes: Nodes) ->
     else:
         turn = nice(float(np.degrees(np.angle(t.axis * 1j / a0))), abs_tol=ANGLE_SNAP)
         tiny = 1e-6 * (float(np.max(np.abs(values))) + 1e-12)
-        for track in values.T / abs(a0):
+        # a row of stretched copies writes offsets and stretches that grow by one step as linear
+        close = LINEAR_SHARE * float(np.min(nodes.slack[t.nodes])) / abs(a0) if t.stretch is not None else 0.0
+        stretch = None if t.stretch is None else t.stretch[::-1]
+        across = 0.0  # offsets that grow by one amount per step: moved by the step instead
+        for c, track in enumerate(values.T / abs(a0)):
             free: tuple[Module, ...] = ()
-            if np.max(np.abs(track)) > tiny:
-                offsets = Linear.of_table(nice_array(track, abs_tol=tiny))
+            offsets = _free_value(track, tiny, close) if np.max(np.abs(track)) > tiny else None
+            if offsets is not None and not offsets.table and values.shape[1] == 1:
+                across, offsets = -offsets.cd, None  # entry m - 1 is the next step's: 0 at the first
+            if offsets is not None:
                 free = (Turtle("+", Linear(turn)), Turtle("f", offsets), Turtle("+", Linear(-turn)))
+            if stretch is not None and np.any(stretch[:, c] != 0):
+                free += (
+                    Turtle("~", _free_value(stretch[:, c], 1e-9 * float(np.max(np.abs(stretch))), close)),
+                )
             draws += [Push(), *free, *table.draw(t.sym, last=True), Pop()]
-        step = const_t(1 + 0j, t.step * t.axis / a0)
+        step = const_t(1 + 0j, (t.step * t.axis + across * abs(a0) * t.axis * 1j) / a0)
     # one case for every m >= 0: each table is written once; P(-1) draws nothing and ends it
     return Rule(name, True, (Case(None, (*draws, *step, Symbol(name, Count(-1, 1)))),))
+
+
+def _free_value(track: np.ndarray, tiny: float, close: float) -> Linear:
+    """The value of entry ``m`` of ``track``: linear in ``m`` when it fits within ``close``, else a table."""
+    if close > 0 and track.size >= 2:
+        m = np.arange(track.size)
+        cd = nice(float(track[-1] - track[0]) / (track.size - 1), abs_tol=0.1 * close / track.size)
+        c0 = nice(float(np.mean(track - cd * m)), abs_tol=0.1 * close)
+        if np.max(np.abs(c0 + cd * m - track)) <= close:
+            return Linear(c0, cd)
+    return Linear.of_table(nice_array(track, abs_tol=tiny))
 
 
 def shortens(prec: Precision, table: SymbolTable, t: Tabulated, rule: Rule, nodes: Nodes) -> bool:
@@ -264,7 +317,7 @@ def shortens(prec: Precision, table: SymbolTable, t: Tabulated, rule: Rule, node
     lever = table.sizes[t.sym] * np.abs(a)
     _, stacks = np.unique(prec.cell_ids(nodes.b[t.nodes]), return_counts=True)
     pose = pose_bits(*prec.pose_model(a, lever), stacks)
-    total = int(np.count_nonzero(nodes.sym == t.sym))
+    total = int(np.count_nonzero(table.stretch_family(nodes.sym) == t.sym))
     alone = placement_set_bits(prec, total, pose=pose, token=token) - placement_set_bits(
         prec, total - n, token=token
     )
@@ -275,6 +328,21 @@ def shortens(prec: Precision, table: SymbolTable, t: Tabulated, rule: Rule, node
         lever_bits = table_bits(prec, scales.table, "*", float(np.median(lever)))
         return bool(rule_bits(prec, token, plain) + lever_bits + call <= alone + RULE_BITS)
     a0 = nodes.a[t.nodes[0]]
+    if t.stretch is not None:  # as written: step, offsets and stretches (tables or linear in m)
+        body = rule.cases[0].body
+        moves = [m for m in body[body.index(Pop()) + 1 : -1] if isinstance(m, Turtle)]
+        written = [m.value for m in body[: body.index(Pop())] if isinstance(m, Turtle) and m.op in ("f", "~")]
+        turns = any(isinstance(m, Turtle) and m.op == "f" for m in body[: body.index(Pop())])
+        coded = (
+            KIND_BITS
+            + token
+            + float(count_bits(t.steps) + count_bits(t.values.shape[1]))
+            + run_bits(prec, moves)
+            + (angle_value_bits(prec, float(np.degrees(np.angle(t.axis * 1j / a0)))) if turns else 0.0)
+            + sum(_value_bits(prec, v) for v in written)
+        )
+        alone += np.count_nonzero(t.stretch) * (OP_BITS + prec.length_bits)
+        return bool(coded + call < alone)
     coded = (
         KIND_BITS
         + token
@@ -284,3 +352,10 @@ def shortens(prec: Precision, table: SymbolTable, t: Tabulated, rule: Rule, node
         + sum(table_bits(prec, track, "f") for track in t.values.T)
     )
     return bool(coded + call < alone)
+
+
+def _value_bits(prec: Precision, v: Linear) -> float:
+    """Bits of a distance written as a table or as ``c0 + cd*m``."""
+    if v.table:
+        return table_bits(prec, v.table, "f")
+    return OP_BITS + prec.length_bits * ((v.c0 != 0) + (v.cd != 0))

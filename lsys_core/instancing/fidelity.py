@@ -20,7 +20,7 @@ from lsys_core.instancing.deviation import pose_deviations
 from lsys_core.instancing.model import Instancing, terminal_shapes
 from lsys_core.svg.model import Scene
 
-__all__ = ["deviations", "split_unfaithful"]
+__all__ = ["deviations", "merge_groups", "split_unfaithful"]
 
 
 def deviations(scene: Scene, inst: Instancing, *, exact: float = 0.0) -> np.ndarray:
@@ -71,7 +71,7 @@ def split_unfaithful(
             part = detect_similarity(sub, threshold=threshold, cancel=cancel)
         else:
             part = _singletons(sub)
-        inst = _merge(inst, bad, part, terminal_name)
+        inst = merge_groups(inst, bad, part, terminal_name)
     return replace(inst, deviation=deviations(scene, inst, exact=exact))
 
 
@@ -96,7 +96,7 @@ def _singletons(sub: Scene) -> Instancing:
     )
 
 
-def _merge(inst: Instancing, bad: np.ndarray, part: Instancing, terminal_name) -> Instancing:
+def merge_groups(inst: Instancing, bad: np.ndarray, part: Instancing, terminal_name) -> Instancing:
     """Replace the groups of elements ``bad`` by the groups of ``part`` (new terminals)."""
     used = np.unique(np.delete(inst.group, bad))
     remap = np.full(len(inst.terminals), -1)

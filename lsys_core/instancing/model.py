@@ -33,6 +33,12 @@ class Instancing:
     deviation : ndarray of float, shape (n,), optional
         Distance of every element from its terminal drawn at its pose (document units), once
         measured (:func:`~lsys_core.instancing.fidelity.split_unfaithful`).
+    stretch_base : ndarray of int, shape (groups,), optional
+        For a terminal that is a stretched copy of another (:mod:`lsys_core.instancing.stretch`),
+        that terminal's index (its *base*); else -1.  None: no stretched copies were looked for.
+    stretch : ndarray of float, shape (groups,), optional
+        The stretch (``~(t)``, in the base's units) that draws each stretched copy from its base;
+        its terminal's path is exactly that stretched shape.
     """
 
     group: np.ndarray
@@ -42,6 +48,8 @@ class Instancing:
     symmetry: np.ndarray
     mirrored_of: np.ndarray
     deviation: np.ndarray | None = None
+    stretch_base: np.ndarray | None = None
+    stretch: np.ndarray | None = None
 
 
 def terminal_shapes(inst: Instancing) -> list[Element]:

@@ -140,3 +140,24 @@ def test_the_editor_freezes_its_long_lived_heap(window, open_rules, wait_idle, q
         qtbot.waitUntil(lambda: gc.get_freeze_count() > first, timeout=30 * FREEZE_AFTER_MS)
     finally:
         gc.unfreeze()
+
+
+BARS = """lsys 4
+terminal A "M -8 -16 L 8 -16 L 8 16 L -8 16 Z" style "fill:#789"
+axiom: f(100) P(3)
+P(m): m > 0 -> [ ~(16*m) A ] +(-90) f(8) +(90) f(22.7) P(m-1)
+P(m): m == 0 -> A
+"""
+
+
+def test_a_grammar_with_stretched_bars_shows_its_stretch_and_draws_them(open_rules, wait_idle):
+    window = open_rules(BARS)
+    wait_idle(window)
+    assert window.rules_view.cards["P"].summary.startswith("row of 4")
+    drawing = window.doc.drawing
+    assert drawing is not None and len(drawing) == 4
+    assert sorted(drawing.stretch.tolist()) == [0.0, 16.0, 32.0, 48.0]
+    labels = {ctl.label for ctl in window.rules_view.cards["P"].controls}
+    assert "stretch change with m" in labels
+    window.canvas.set_highlight_terminal(0)  # the stretched bars are instances of A too
+    assert window.canvas._highlight is not None and window.canvas._highlight.all()

@@ -348,7 +348,7 @@ ERRORS = [
     ("", 1, 1, "missing header"),
     ("# only a comment\n", 1, 1, "missing header"),
     ('terminal A "M0 0"\n', 1, 1, "expected the header"),
-    ("lsys 4\n", 1, 6, "unsupported format version 4"),
+    ("lsys 5\n", 1, 6, "unsupported format version 5"),
     ("lsys\n", 1, 5, "expected a format version"),
     (HEAD + "axiom: A\nlsys 1\n", 4, 1, "duplicate header"),
     (HEAD + "axiom: A\nX A\n", 4, 3, "expected '->'"),
