@@ -69,16 +69,35 @@ def match_instances(
         if mine.size != theirs.size:
             return None
         if mine.size <= _ASSIGN_LIMIT:
-            from scipy.optimize import linear_sum_assignment
-
             cost = np.abs(eb[mine][:, None] - b[theirs][None, :]) + scale * 1e-3 * np.abs(
                 ea[mine][:, None] - a[theirs][None, :]
             )
-            rows, cols = linear_sum_assignment(cost)
+            rows, cols = _assignment(cost, scale)
             out[theirs[cols]] = mine[rows]
         else:
             out[theirs] = _greedy(eb[mine], b[theirs], mine)
     return out
+
+
+def _assignment(cost: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]:
+    """The one-to-one matching of least total ``cost`` (rows, columns), as ``linear_sum_assignment`` gives it.
+
+    When every row's cheapest column is a different column, each clearly (by ``1e-9·scale``)
+    cheaper than the row's others, that matching is the only optimum and is taken as it is:
+    a derivation that reproduces its drawing always matches so, and importing scipy's
+    optimiser and solving took 0.15-0.45 s of a 1,200-leaf grid's whole run.
+    """
+    n = cost.shape[0]
+    if n == 1:
+        return np.zeros(1, np.intp), np.zeros(1, np.intp)
+    if n >= 2:
+        two = np.partition(cost, 1, axis=1)
+        cols = np.argmin(cost, axis=1)
+        if np.all(two[:, 1] > two[:, 0] + 1e-9 * scale) and np.unique(cols).size == n:
+            return np.arange(n), cols
+    from scipy.optimize import linear_sum_assignment
+
+    return linear_sum_assignment(cost)
 
 
 def _greedy(target: np.ndarray, found: np.ndarray, ids: np.ndarray) -> np.ndarray:

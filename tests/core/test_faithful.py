@@ -294,3 +294,21 @@ def test_paint_order_moves_are_not_geometry_for_sliders_and_rule_cards() -> None
     card = next(c for c in describe(g) if c.owner == "P")
     assert card.kind == "arc" and card.count == 6
     assert {w.key for c in card.controls for w in c.writes} == {"axiom.0.0.m", "P.0.2.v", "P.0.3.v"}
+
+
+def test_matching_without_the_optimiser_is_the_optimisers_matching() -> None:
+    from scipy.optimize import linear_sum_assignment
+
+    from lsys_core.derive.faithful import _assignment
+
+    rng = np.random.default_rng(11)
+    for n in (1, 2, 5, 40):
+        for jitter in (0.0, 0.01, 0.6):  # clear matches, near ones, a muddle where the optimiser decides
+            points = rng.uniform(0, 10, n) + 1j * rng.uniform(0, 10, n)
+            moved = rng.permutation(points) + jitter * (rng.normal(size=n) + 1j * rng.normal(size=n))
+            cost = np.abs(points[:, None] - moved[None, :])
+            rows, cols = _assignment(cost, 10.0)
+            want_rows, want_cols = linear_sum_assignment(cost)
+            assert rows.tolist() == want_rows.tolist() and cols.tolist() == want_cols.tolist()
+    tie = np.zeros((3, 3))  # every matching is optimal: the optimiser's choice is kept
+    assert [c.tolist() for c in _assignment(tie, 1.0)] == [c.tolist() for c in linear_sum_assignment(tie)]

@@ -44,3 +44,21 @@ def test_suppression_keeps_what_the_greedy_loop_keeps(seed: int) -> None:
             expected.append(i)
             suppressed[near] = True
     assert clustering._suppress(seeds, order).tolist() == expected
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_support_of_seeds_that_stopped_is_that_of_a_new_query(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    lone = rng.uniform(0, 400, (300, 3))  # far apart: they stop where they start
+    crowd = rng.normal(0, 0.4, (200, 3)) + 500.0  # they move, then stop near each other
+    points = np.vstack([lone, crowd])
+    weights = rng.integers(1, 5, len(points)).astype(float)
+    tree = cKDTree(points)
+    seeds = points.copy()
+    seeds[300:] = points[300:].mean(axis=0)  # moved seeds: queried again
+    owner, flat = clustering._ball_pairs(seeds[:300], tree)
+    kept = clustering._support(seeds, tree, weights, [owner], [flat])
+    owner, flat = clustering._ball_pairs(seeds, tree)
+    fresh = np.bincount(owner, weights=weights[flat], minlength=len(seeds))
+    assert kept.tobytes() == fresh.tobytes()
+    assert (fresh[300:] > 100).all() and (fresh[:300] >= 1).all()
