@@ -169,8 +169,12 @@ def rule_bits(prec: Precision, token: float, rule: Rule) -> float:
     return bits
 
 
-def _placements(body: tuple[Module, ...]) -> list[tuple[Symbol, complex, complex]] | None:
-    """The body as placements ``[ turtle… Symbol ]`` with their relative frames, or None if it is not one."""
+def _placements(body: tuple[Module, ...]) -> list[tuple[Symbol, complex, complex, list[Turtle]]] | None:
+    """The body as placements ``[ turtle… Symbol ]`` with their relative frames, or None if it is not one.
+
+    Each placement comes with its turtle commands that are not moves (stretches, paint order),
+    which the set code charges one by one.
+    """
     out = []
     i = 0
     while i < len(body):
@@ -187,18 +191,21 @@ def _placements(body: tuple[Module, ...]) -> list[tuple[Symbol, complex, complex
             return None
         sym = body[i]
         assert isinstance(sym, Symbol)
-        out.append((sym, frame[0], frame[1]))
+        out.append((sym, frame[0], frame[1], [t for t in ts if t.op in ("z", "~")]))
         i += 2
     return out if len(out) >= 2 else None
 
 
 def _set_code(
-    prec: Precision, token: float, items: list[tuple[Symbol, complex, complex]], radius: dict[str, float]
+    prec: Precision,
+    token: float,
+    items: list[tuple[Symbol, complex, complex, list[Turtle]]],
+    radius: dict[str, float],
 ) -> float:
-    by_name: dict[str, list[tuple[Symbol, complex, complex]]] = {}
+    by_name: dict[str, list[tuple[Symbol, complex, complex, list[Turtle]]]] = {}
     for it in items:
         by_name.setdefault(it[0].name, []).append(it)
-    bits = OP_BITS
+    bits = OP_BITS + sum(_turtle_bits(prec, t) for it in items for t in it[3])
     for name, group in by_name.items():
         a = np.array([g[1] for g in group])
         lever = radius.get(name, prec.diagonal) * np.abs(a)

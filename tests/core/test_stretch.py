@@ -175,3 +175,14 @@ def test_ellipses_of_different_aspect_are_not_stretched_copies() -> None:
         elements.append(Element(c, np.zeros(4, int), (True,), "fill:#000"))
     inst = analyse(Scene(tuple(elements), (0.0, 0.0, 300.0, 200.0))).instancing
     assert inst.stretch_base is None or np.all(inst.stretch_base < 0)
+
+
+def test_stretches_cost_bits_in_a_rule_that_places_shapes_one_by_one() -> None:
+    from lsys_core.hierarchy.describe import grammar_bits
+    from lsys_core.hierarchy.mdl import Precision
+
+    prec = Precision.of_box(0j, 400 + 400j, 1.0)
+    head = 'lsys 4\nterminal A "M -8 -16 L 8 -16 L 8 16 L -8 16 Z"\naxiom: Z\n'
+    plain = parse_grammar(head + "Z -> [ A ] [ f(30) A ] [ f(60) A ]\n")
+    stretched = parse_grammar(head + "Z -> [ A ] [ f(30) ~(16.5) A ] [ f(60) ~(47.25) A ]\n")
+    assert grammar_bits(stretched, prec) > grammar_bits(plain, prec) + 2 * prec.length_bits
