@@ -171,8 +171,9 @@ def _scaled_strokes(g: Grammar, styles: np.ndarray, drawing: Drawing) -> tuple[G
     scale = np.abs(np.asarray(drawing.a, complex))
     styles = styles.copy()
     scaled = set()
-    for t, term in enumerate(drawing.terminals):
-        mine = np.flatnonzero(drawing.symbol == t)
+    base = drawing.base_symbol()  # a stretched instance is one of its terminal's
+    for t, term in enumerate(drawing.terminals[: len(g.terminals)]):
+        mine = np.flatnonzero(base == t)
         if mine.size < 2 or term.scaled or np.ptp(scale[mine]) <= _SCALED_TOL * scale[mine].max():
             continue
         local = _local_lengths([str(v) for v in styles[mine]], scale[mine])

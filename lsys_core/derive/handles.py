@@ -141,7 +141,7 @@ def find_handles(g: Grammar, drawing: Drawing, index: int, knob: float) -> Handl
         c.owner for c in cards.values() if own in c.calls and c.kind not in ("group", "branching", "start")
     ]
     rules = np.asarray(drawing.rule)
-    symbols = np.asarray(drawing.symbol)
+    symbols = drawing.base_symbol()  # stretched instances are their terminal's
     same = np.flatnonzero((rules == rule_idx) & (symbols == symbols[index]))
     positions = np.asarray(drawing.b)[same]
     size = float(np.ptp(positions.real) + np.ptp(positions.imag)) if positions.size else 0.0
@@ -196,7 +196,7 @@ def _anchor(g: Grammar, drawing: Drawing, index: int, own: str) -> tuple[complex
     names = [t.name for t in drawing.terminals]
     if not isinstance(first, Symbol) or first.name not in names:
         return None
-    rules, symbols = np.asarray(drawing.rule), np.asarray(drawing.symbol)
+    rules, symbols = np.asarray(drawing.rule), drawing.base_symbol()
     mine = np.flatnonzero((rules == drawing.rule[index]) & (symbols == symbols[index]))
     k = int(np.searchsorted(mine, index))
     firsts = np.flatnonzero((rules == drawing.rule[index]) & (symbols == names.index(first.name)))

@@ -186,3 +186,13 @@ def test_stretches_cost_bits_in_a_rule_that_places_shapes_one_by_one() -> None:
     plain = parse_grammar(head + "Z -> [ A ] [ f(30) A ] [ f(60) A ]\n")
     stretched = parse_grammar(head + "Z -> [ A ] [ f(30) ~(16.5) A ] [ f(60) ~(47.25) A ]\n")
     assert grammar_bits(stretched, prec) > grammar_bits(plain, prec) + 2 * prec.length_bits
+
+
+def test_a_stretched_instance_of_a_sequence_gets_the_sequence_handles() -> None:
+    from lsys_core.derive.handles import find_handles
+
+    g = parse_grammar(BARS.split("Q(m)")[0])
+    drawing = derive(g)
+    plain, stretched = find_handles(g, drawing, 0, 10.0), find_handles(g, drawing, 2, 10.0)
+    assert plain is not None and stretched is not None
+    assert stretched.rule == plain.rule == "P"
