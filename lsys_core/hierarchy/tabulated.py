@@ -150,14 +150,16 @@ def _pose_groups(idx: np.ndarray, nodes: Nodes, size: float, period: float, q: f
     return [idx[inv == g] for g in range(int(inv.max(initial=-1)) + 1)]
 
 
-def _level_runs(along: np.ndarray, q: float) -> list[tuple[np.ndarray, int, float]]:
+def _level_runs(
+    along: np.ndarray, q: float, merge: float | None = None
+) -> list[tuple[np.ndarray, int, float]]:
     """Runs of evenly spaced levels holding equally many values each.
 
-    ``along`` is sorted; values within ``q`` of the previous one share a level.  Returns
-    ``(indices into along, count per level, step)`` of every run of at least
+    ``along`` is sorted; values within ``merge`` (default ``q``) of the previous one share a
+    level.  Returns ``(indices into along, count per level, step)`` of every run of at least
     :data:`MIN_COPIES` levels whose places fit ``start + i·step`` within ``q``.
     """
-    new_level = np.concatenate(([True], np.diff(along) > q))
+    new_level = np.concatenate(([True], np.diff(along) > (q if merge is None else merge)))
     starts = np.flatnonzero(new_level)
     counts = np.diff(np.append(starts, along.size))
     level = np.add.reduceat(along, starts) / counts
@@ -175,12 +177,22 @@ def _level_runs(along: np.ndarray, q: float) -> list[tuple[np.ndarray, int, floa
             step = float(gaps[i]) if i < gaps.size else 0.0
             bad = np.flatnonzero(np.abs(span - k * step) > q)
             j = i + (int(bad[0]) - 1 if bad.size else j - i)
-        if j - i + 1 >= MIN_COPIES and step > 2 * q:
+        if j - i + 1 >= MIN_COPIES and step > 2 * (q if merge is None else merge):
             runs.append((np.arange(starts[i], starts[j] + counts[j]), int(counts[i]), float(step)))
             i = j + 1
         else:
             i += 1
     return runs
+
+
+def _merge(along: np.ndarray) -> float:
+    """How close copies of a row of stretched copies must be along it to share a level.
+
+    Bars of a chart stand apart by their spacing, which may be less than the tolerance in a
+    wide chart: a quarter of the median gap between distinct places keeps them apart.
+    """
+    gaps = np.diff(np.unique(along))
+    return 0.25 * float(np.median(gaps)) if gaps.size else 0.0
 
 
 def _rows(
@@ -201,7 +213,9 @@ def _rows(
             for axis in AXES:
                 along = (nodes.b[members] / axis).real
                 order = np.lexsort((first[members], along))
-                for at, k, step in _level_runs(along[order], q):
+                for at, k, step in _level_runs(
+                    along[order], q, _merge(along) if stretch is not None else None
+                ):
                     if best is None or at.size > best[1].size:
                         best = (axis, members[order[at]], k, step)
             if best is None:

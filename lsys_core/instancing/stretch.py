@@ -42,6 +42,8 @@ __all__ = ["stretch_families"]
 _AXES = (1 + 0j, 1j)
 #: Lengths closer than this share of the tolerance are one length (one terminal).
 _SAME_LENGTH = 1e-3
+#: Shapes shorter than this share of the tolerance along the axis are flat: never stretched.
+_FLAT = 1e-3
 
 
 def _profiles(cubics: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -91,9 +93,9 @@ def _families(scene: Scene, free: np.ndarray, tol: float) -> list[tuple[complex,
             _, inv = np.unique(key, axis=0, return_inverse=True)
             inv = inv.ravel()
             for g in np.unique(inv):
-                members = idx[inv == g]
-                lengths = length[inv == g]
-                if members.size >= 2 and np.ptp(lengths) > tol and lengths.min() > tol:
+                sel = (inv == g) & (length > _FLAT * tol)  # a flat shape has no halves to pull apart
+                members, lengths = idx[sel], length[sel]
+                if members.size >= 2 and np.ptp(lengths) > tol:
                     out.append((axis, members))
                     taken[members] = True
     return out

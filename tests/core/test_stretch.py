@@ -196,3 +196,14 @@ def test_a_stretched_instance_of_a_sequence_gets_the_sequence_handles() -> None:
     plain, stretched = find_handles(g, drawing, 0, 10.0), find_handles(g, drawing, 2, 10.0)
     assert plain is not None and stretched is not None
     assert stretched.rule == plain.rule == "P"
+
+
+def test_bars_closer_than_the_tolerance_are_still_one_row() -> None:
+    from lsys_core.settings import InferenceSettings
+
+    rng = np.random.default_rng(11)
+    s = _bars(np.round(rng.uniform(3, 250, 30), 1), step=12.0, width=10.0)
+    result = infer(s, InferenceSettings(deviation=15.0))  # a wide chart: 0.5 % of its diagonal
+    assert result.log == ("P1: a row with offsets of 30 nodes (table)",)
+    assert result.max_deviation <= 15.0
+    assert_scenes_close(s, drawing_scene(derive(result.grammar)))
