@@ -14,7 +14,7 @@ from lsys_core.instancing.roundness import round_within, turn_deviation
 from lsys_core.pipeline import infer
 from lsys_core.render.structured import drawing_to_structured_svg
 from lsys_core.svg import parse_svg
-from lsys_core.svg.model import Element
+from lsys_core.svg.model import Element, Scene
 from lsys_core.testing import drawing_scene, hausdorff_rel
 
 from .scenes import LEAF, place, scene
@@ -175,7 +175,6 @@ def test_merge_within_joins_near_identical_groups_of_one_size_only() -> None:
     from lsys_core.grammar.model import Terminal
     from lsys_core.instancing.fidelity import deviations
     from lsys_core.instancing.merge import merge_within
-    from lsys_core.svg.model import Scene
 
     shapes = [_rect(4.8, 7.8), _rect(5.0, 7.8, reverse=True), _rect(9.6, 15.6)]
     where = [10 + 10j, 30 + 10j, 50 + 10j, 80 + 10j]
@@ -225,3 +224,23 @@ def test_leaves_small_against_the_tolerance_keep_their_turns() -> None:
     np.testing.assert_allclose(
         theirs, np.sort(np.round(np.angle(r.instancing.a[:18], deg=True)) % 360), atol=1.0
     )
+
+
+def test_many_distinct_shapes_are_not_measured_against_each_other(monkeypatch) -> None:
+    """A map of distinct blobs: sizes and a sampled lower bound rule pairs out before measuring."""
+    import lsys_core.instancing.merge as merge
+
+    rng = np.random.default_rng(3)
+    blobs = []
+    for _ in range(60):
+        k = int(rng.integers(5, 30))
+        corners = rng.uniform(5, 25, k) * np.exp(2j * np.pi * np.arange(k) / k)
+        ends = np.roll(corners, -1)
+        outline = np.stack([corners, (2 * corners + ends) / 3, (corners + 2 * ends) / 3, ends], axis=1)
+        blobs.append(outline + complex(*rng.uniform(0, 2000, 2)))
+    measured = []
+    real = merge.pose_deviations
+    monkeypatch.setattr(merge, "pose_deviations", lambda *a, **k: measured.append(1) or real(*a, **k))
+    result = infer(Scene(tuple(e[0] for e in (_closed(place(b, [(1 + 0j, 0j)])) for b in blobs))))
+    assert result.grammar.production_count == 1  # distinct blobs at random places: no rule
+    assert len(measured) <= 6  # trying every pair of near descriptors measured 1,244 poses here
