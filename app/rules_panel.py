@@ -317,8 +317,7 @@ class RulesEditor(QPlainTextEdit):
             self.highlighter.defer()
         doc = self.document()
         end = doc.characterCount() - 1
-        cursor = QTextCursor(doc)
-        cursor.beginEditBlock()
+        cursor = QTextCursor(doc)  # one edit each: an edit block would colour every line between
         for i1, i2, j1, j2 in reversed(edits):
             new = b[j1:j2]
             if i1 < i2 and new:  # lines replaced: the line breaks around them stay
@@ -336,7 +335,6 @@ class RulesEditor(QPlainTextEdit):
             cursor.setPosition(start)
             cursor.setPosition(stop, QTextCursor.MoveMode.KeepAnchor)
             cursor.insertText(insert)
-        cursor.endEditBlock()
         if many:
             self.highlighter.resume(self.firstVisibleBlock().blockNumber())
         self._refresh_selections()

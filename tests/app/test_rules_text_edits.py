@@ -64,3 +64,24 @@ def test_a_long_line_is_coloured_at_its_head_and_its_tail_stays_plain(qtbot):
     ranges = editor.document().findBlockByNumber(1).layout().formats()
     assert ranges, "the head of the line is coloured"
     assert max(r.start + r.length for r in ranges) <= rules_panel._TOKEN_COLOURS < len(axiom)
+
+
+def test_changes_at_both_ends_colour_only_the_changed_lines(qtbot, monkeypatch):
+    coloured: list[str] = []
+    real = rules_panel.LsysHighlighter.highlightBlock
+    monkeypatch.setattr(
+        rules_panel.LsysHighlighter,
+        "highlightBlock",
+        lambda self, text: coloured.append(text) or real(self, text),
+    )
+    editor = RulesEditor()
+    qtbot.addWidget(editor)
+    lines = ["lsys 1", "axiom: P0(3)"] + [f"P{i}(m): m > 0 -> A f({i}) P{i}(m-1)" for i in range(30)]
+    editor.replace_text("\n".join(lines))
+    qtbot.waitUntil(lambda: not editor.highlighter.pending, timeout=10_000)
+    assert len(coloured) >= len(lines)  # the first text: every line
+    coloured.clear()
+    lines[1], lines[-1] = "axiom: P1(4)", "P29(m): m > 0 -> A f(2.9) P29(m-1)"
+    editor.replace_text("\n".join(lines))
+    assert editor.toPlainText() == "\n".join(lines)
+    assert {lines[1], lines[-1]} <= set(coloured) <= {lines[1], lines[2], lines[-1]}  # not the 28 between
