@@ -3,7 +3,9 @@
 Run with `make bench` (or directly).  Whole `lsys infer` processes on (1) 3,000 copies of one
 triangle in one pose at random places, whose offsets coincide by chance (target: at most 3
 productions, at most 3 s on 2 cores), and (2) 20 copies at random angles (target: no rule
-claims a rotation sequence).  Prints productions, repetition rules found, seconds and the load.
+claims a rotation sequence), and (3) distinct blobs at random places, a map (nothing to group or
+repeat: the time shows what the similarity search costs when every candidate fails).  Prints
+productions, repetition rules found, seconds and the load.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from scenes import scattered_svg, write
+from scenes import blobs_svg, scattered_svg, write
 
 LSYS = [sys.executable, "-m", "lsys_core.cli"]
 
@@ -44,6 +46,16 @@ def main() -> int:
                 f"{n:>5,} copies at random {'angles' if turn else 'places'}: {productions} productions, "
                 f"{len(sequences)} sequence rules, explained {report.get('explained', 0):.0%}, "
                 f"{seconds:.2f} s (load {load:.1f}; target {target})",
+                flush=True,
+            )
+        for n in (100, 250):
+            svg = write(work / f"blobs-{n}.svg", blobs_svg(n))
+            load = os.getloadavg()[0]
+            seconds, report = run(svg, work / f"blobs-{n}.lsys")
+            stages = report.get("stages", {})
+            print(
+                f"{n:>5,} distinct blobs: {report.get('explained', 0):.0%} explained, {seconds:.2f} s "
+                f"(similarity {stages.get('similarity', 0):.2f} s; load {load:.1f})",
                 flush=True,
             )
     return 0

@@ -50,6 +50,28 @@ def scattered_svg(n: int, seed: int = 7, size: float = 1000.0, turn: bool = Fals
     )
 
 
+def blobs_svg(n: int, seed: int = 3, size: float = 2000.0) -> str:
+    """``n`` distinct blobs (polygons of 5-30 corners at random radii) at random places: a map."""
+    import random
+
+    rng = random.Random(seed)
+    parts = []
+    for _ in range(n):
+        cx, cy, k = rng.uniform(0, size), rng.uniform(0, size), rng.randint(5, 30)
+        pts = " ".join(
+            f"{cx + r * math.cos(2 * math.pi * j / k):.2f},{cy + r * math.sin(2 * math.pi * j / k):.2f}"
+            for j, r in enumerate(rng.uniform(5, 25) for _ in range(k))
+        )
+        parts.append(
+            f'<polygon fill="#{rng.randrange(0xFFFFFF):06x}" stroke="#333" stroke-width="0.5" points="{pts}"/>'
+        )
+    return (
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{size}" viewBox="0 0 {size} {size}">\n'
+        + "\n".join(parts)
+        + "\n</svg>\n"
+    )
+
+
 def grid_dims(n: int) -> tuple[int, int]:
     """Rows and columns of a roughly 3:4 grid with about ``n`` elements (1200 -> 30 x 40)."""
     rows = max(1, round(math.sqrt(n * 3 / 4)))
