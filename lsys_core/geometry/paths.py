@@ -25,6 +25,7 @@ __all__ = [
     "arc_cubics",
     "arrays_from_table",
     "assemble",
+    "collinear_thirds",
     "cubics_from_d",
     "cubics_from_table",
     "d_from_cubics",
@@ -244,8 +245,12 @@ def cubics_from_d(d: str) -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
     return cubics_from_table(table)
 
 
-def _collinear_thirds(cubics: np.ndarray, tol: float) -> np.ndarray:
-    """Return a mask of segments whose control points lie at 1/3 and 2/3 of the chord."""
+def collinear_thirds(cubics: np.ndarray, tol) -> np.ndarray:
+    """Return a mask of segments whose control points lie at 1/3 and 2/3 of the chord.
+
+    Such a cubic is a straight segment drawn at constant speed (path data writes it ``L``).
+    ``tol`` is a distance, one for all or one per segment.
+    """
     p0, c1, c2, p3 = cubics.T
     d = p3 - p0
     return (np.abs(c1 - (p0 + d / 3.0)) <= tol) & (np.abs(c2 - (p0 + 2.0 * d / 3.0)) <= tol)
@@ -295,7 +300,7 @@ def d_from_cubics(
     first[1:] = (subpaths[1:] != subpaths[:-1]) | (np.abs(p_start[1:] - cubics[:-1, 3]) > tol)
     last = np.ones(k, dtype=bool)
     last[:-1] = subpaths[1:] != subpaths[:-1]
-    is_line = _collinear_thirds(cubics, tol)
+    is_line = collinear_thirds(cubics, tol)
     sub_start = p_start[first][np.cumsum(first) - 1]  # start of the contour of each segment
     n_sub = int(subpaths.max()) + 1
     closed_arr = np.zeros(n_sub, dtype=bool)

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from lsys_core.geometry.paths import collinear_thirds
+
 __all__ = ["stretch_cubics", "stretch_path"]
 
 #: A cubic whose inner control points lie within this share of its chord from a third and two
@@ -31,10 +33,8 @@ def stretch_cubics(cubics: np.ndarray, t: float) -> np.ndarray:
     y = c.imag
     side = np.where(np.abs(y) <= 1e-12 * max(extent, 1e-300), 0.0, np.sign(y))
     out = c + 1j * (0.5 * float(t)) * side
-    p0, p3 = c[:, 0], c[:, 3]
-    chord = np.abs(p3 - p0)
-    off = np.maximum(np.abs(c[:, 1] - (2 * p0 + p3) / 3), np.abs(c[:, 2] - (p0 + 2 * p3) / 3))
-    straight = (chord > 0) & (off <= _STRAIGHT * np.maximum(chord, 1e-300))
+    chord = np.abs(c[:, 3] - c[:, 0])
+    straight = (chord > 0) & collinear_thirds(c, _STRAIGHT * np.maximum(chord, 1e-300))
     q0, q3 = out[straight, 0], out[straight, 3]
     out[straight, 1] = (2 * q0 + q3) / 3
     out[straight, 2] = (q0 + 2 * q3) / 3

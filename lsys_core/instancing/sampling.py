@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lsys_core.geometry.paths import collinear_thirds
 from lsys_core.svg.model import Element
 
 __all__ = ["Samples", "arc_fractions", "bezier", "element_features", "sample_elements"]
@@ -101,12 +102,8 @@ def _chord_table(cubics: np.ndarray) -> np.ndarray:
     out = np.empty((cubics.shape[0], _TABLE))
     for lo in range(0, cubics.shape[0], _CHUNK):
         c = cubics[lo : lo + _CHUNK]
-        chord = c[:, 3] - c[:, 0]
-        tiny = 1e-12 * np.maximum(np.abs(c).max(axis=1), 1.0)
-        straight = (np.abs(3.0 * (c[:, 1] - c[:, 0]) - chord) <= tiny) & (
-            np.abs(3.0 * (c[:, 3] - c[:, 2]) - chord) <= tiny
-        )
-        out[lo : lo + c.shape[0]][straight] = (np.abs(chord[straight]) / _TABLE)[:, None]
+        straight = collinear_thirds(c, 1e-12 / 3.0 * np.maximum(np.abs(c).max(axis=1), 1.0))
+        out[lo : lo + c.shape[0]][straight] = (np.abs(c[straight, 3] - c[straight, 0]) / _TABLE)[:, None]
         curved = np.flatnonzero(~straight)
         if curved.size:
             k = curved.size

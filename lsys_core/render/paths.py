@@ -150,7 +150,7 @@ _EMPTY = _Geometry(
 
 def _geometry(d: str) -> _Geometry:
     """Turn path data into skia points and verbs (lines where control points sit at thirds)."""
-    from lsys_core.geometry.paths import _collinear_thirds
+    from lsys_core.geometry.paths import collinear_thirds
     from lsys_core.geometry.shapes import shape_arrays
 
     try:
@@ -161,7 +161,7 @@ def _geometry(d: str) -> _Geometry:
     if k == 0 or not np.isfinite(cubics).all():
         return _EMPTY
     scale = float(np.abs(cubics).max()) or 1.0
-    is_line = _collinear_thirds(cubics, 1e-9 * scale)
+    is_line = collinear_thirds(cubics, 1e-9 * scale)
     first = np.ones(k, dtype=bool)
     first[1:] = (subpaths[1:] != subpaths[:-1]) | (cubics[1:, 0] != cubics[:-1, 3])
     last = np.ones(k, dtype=bool)
