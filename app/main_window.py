@@ -269,13 +269,14 @@ class MainWindow(WindowFiles, WindowEdits, QMainWindow):
         """Update the panels for ``grammar``, yielding between panels."""
         yield from self.params_panel.param_steps(core.list_params(grammar))
         yield
-        cards: list[Any] = []
+        made: list[Any] = []
         for card in core.describe_iter(grammar):
-            cards.append(card)
-            if len(cards) % CARDS_PER_TURN == 0:
+            made.append(card)
+            if len(made) % CARDS_PER_TURN == 0:
                 yield
+        cards = tuple(made)
         yield
-        yield from self.rules_view.card_steps(grammar, tuple(cards))
+        yield from self.rules_view.card_steps(grammar, cards)
         yield
         self.structure_panel.set_content(grammar, cards, self.doc.drawing)
         yield

@@ -153,10 +153,11 @@ class StructurePanel(QWidget):
         self._updating = True
         try:
             by_owner = {c.owner: c for c in cards}
+            counts = self._count_texts(drawing)
             tree_key = tuple((c.owner, c.terminals, c.calls) for c in cards)
             if tree_key != self._tree_key:  # the structure changed: rebuild (else only the words)
                 self._tree_key = tree_key
-                self._fill_tree(grammar, by_owner, self._count_texts(drawing))
+                self._fill_tree(grammar, by_owner, counts)
             else:
                 for name, items in self._items.items():
                     card = by_owner.get(name)
@@ -168,7 +169,8 @@ class StructurePanel(QWidget):
             if palette_key != self._palette_key:
                 self._palette_key = palette_key
                 self._fill_palette(grammar)
-            self.set_drawing(drawing)
+            if drawing is not None:
+                self._show_counts(counts)
             if selected:
                 self.select_rule(selected)
             if term_selected:
@@ -254,7 +256,9 @@ class StructurePanel(QWidget):
         if not self.isVisible():
             self._stale = True
             return
-        texts = self._count_texts(drawing)
+        self._show_counts(self._count_texts(drawing))
+
+    def _show_counts(self, texts: dict[str, str]) -> None:
         for name, items in self._items.items():
             text = texts.get(name, "")
             for item in items:

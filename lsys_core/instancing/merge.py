@@ -144,7 +144,7 @@ def merge_within(scene: Scene, inst: Instancing, tolerance: float) -> Instancing
         g = int(drawable[host])
         if g in gone:
             continue
-        own = float(np.median(np.abs(a[group == g]))) * r[host]  # the host's size as drawn
+        own = float(sizes[host])  # the host's size as drawn (its members have not moved yet)
         for i in sorted(near.get(host, []), key=lambda k: rank[k]):
             h = int(drawable[i])
             if h in gone or rank[i] < rank[host] or g in (inst.mirrored_of[h], h) or inst.mirrored_of[g] == h:
