@@ -96,20 +96,33 @@ def parse_paths(ds: list[str], max_numbers: int | None = None) -> PathTable:
     (:class:`~lsys_core.errors.LimitError` beyond).
     """
     n_paths = len(ds)
+    messages: list[str | None] = [None] * n_paths
+    cmds = _commands(ds, max_numbers, messages)
+    return _execute(*cmds, n_paths, tuple(messages))
+
+
+def _commands(ds: list[str], max_numbers: int | None, messages: list[str | None]) -> tuple:
+    """Lex the paths and keep each one's commands up to its first error (noted in ``messages``).
+
+    Returns ``(letters, first, arity, groups, let_path, values)`` for :func:`_execute`: the lexing
+    arrays die with this call (for 10^6 commands they are about 100 MiB beside these).
+    """
+    n_paths = len(ds)
     lens = np.fromiter((len(d) for d in ds), dtype=np.int64, count=n_paths)
     offs = np.cumsum(lens + 1) - (lens + 1)  # each path's first byte in the joined text
     ends = offs + lens
     joined = "\n".join(ds)
     lexed = lex(joined, max_numbers=max_numbers)
     values, starts, letters, lpos = lexed.values, lexed.starts, lexed.letters, lexed.letter_pos
-    messages: list[str | None] = [None] * n_paths
+    lex_errors = lexed.errors
+    del lexed
     # Each path is read up to its first error.
     cut = ends.copy()
-    if lexed.errors.size:
-        err_path = np.searchsorted(offs, lexed.errors, side="right") - 1
+    if lex_errors.size:
+        err_path = np.searchsorted(offs, lex_errors, side="right") - 1
         first_err, where = np.unique(err_path, return_index=True)
-        cut[first_err] = lexed.errors[where]
-        for p, e in zip(first_err.tolist(), lexed.errors[where].tolist(), strict=True):
+        cut[first_err] = lex_errors[where]
+        for p, e in zip(first_err.tolist(), lex_errors[where].tolist(), strict=True):
             messages[p] = f"unexpected character at offset {e - int(offs[p])}"
     tok_path = np.searchsorted(offs, starts, side="right") - 1
     let_path = np.searchsorted(offs, lpos, side="right") - 1
@@ -137,9 +150,14 @@ def parse_paths(ds: list[str], max_numbers: int | None = None) -> PathTable:
             messages[p] = "path data must begin with a move command (M or m)"
     keep_tok &= good_start[tok_path]
     keep_let &= good_start[let_path]
-    values, starts, tok_path = values[keep_tok], starts[keep_tok], tok_path[keep_tok]
-    letters, lpos, let_path = letters[keep_let], lpos[keep_let], let_path[keep_let]
+    del tok_path
+    if not keep_tok.all():  # (all kept: no copies)
+        values, starts = values[keep_tok], starts[keep_tok]
+    if not keep_let.all():
+        letters, lpos, let_path = letters[keep_let], lpos[keep_let], let_path[keep_let]
+    del keep_tok, keep_let
     first = np.searchsorted(starts, lpos)  # first number after each command letter
+    del starts
     count = np.diff(first, append=values.size)
     arity = _ARITY[letters]
     values, first, count = _fix_arc_flags(
@@ -161,7 +179,7 @@ def parse_paths(ds: list[str], max_numbers: int | None = None) -> PathTable:
                 ordinal = c - int(np.searchsorted(let_path, p))
                 messages[p] = f"{what} for command {chr(letters[c])} (number {ordinal + 1})"
         letters, first, arity, groups, let_path = (x[keep] for x in (letters, first, arity, groups, let_path))
-    return _execute(letters, first, arity, groups, let_path, values, n_paths, tuple(messages))
+    return letters, first, arity, groups, let_path, values
 
 
 def _fix_arc_flags(text, letters, lpos, limit, values, first, count):
@@ -253,9 +271,17 @@ def _arc_args(text: bytes) -> np.ndarray:
 
 def _reset_sum(values: np.ndarray, reset: np.ndarray) -> np.ndarray:
     """Prefix sums that restart at every ``reset`` row (where the row's own value is the start)."""
-    cs = np.cumsum(np.where(reset, 0, values))
-    last = np.maximum.accumulate(np.where(reset, np.arange(values.size), 0))
-    return values[last] * reset[last] + cs - cs[last]
+    cs = np.where(reset, 0, values)
+    np.cumsum(cs, out=cs)
+    last = np.arange(values.size)
+    last[~reset] = 0
+    np.maximum.accumulate(last, out=last)
+    # In place: the same operations as ``values[last] * reset[last] + cs - cs[last]``.
+    out = values[last]
+    out *= reset[last]
+    out += cs
+    out -= cs[last]
+    return out
 
 
 def _execute(letters, first, arity, groups, let_path, values, n_paths, errors) -> PathTable:
@@ -265,8 +291,7 @@ def _execute(letters, first, arity, groups, let_path, values, n_paths, errors) -
         return _empty(errors)
     cmd = np.repeat(np.arange(letters.size), groups)
     g = np.arange(n) - np.repeat(np.cumsum(groups) - groups, groups)  # group index within command
-    k = arity[cmd]
-    base_idx = first[cmd] + g * k
+    base_idx = first[cmd] + g * arity[cmd]
     path = let_path[cmd]
     del cmd
     letter = np.repeat(letters, groups)
@@ -334,8 +359,7 @@ def _execute(letters, first, arity, groups, let_path, values, n_paths, errors) -
 def _group_offsets(is_move, close, setc, e):
     """Offsets within subpath groups: per row, ``(offset, known)``; known rows are absolute."""
     reset = is_move | close | setc
-    val = np.where(setc & ~is_move, e, 0.0)
-    off = _reset_sum(np.where(reset, val, e), reset)
+    off = _reset_sum(np.where(reset, np.where(setc & ~is_move, e, 0.0), e), reset)
     anchor = np.maximum.accumulate(np.where(reset, np.arange(e.size), 0))
     known = setc[anchor] & ~is_move[anchor]
     return off, known
@@ -367,8 +391,22 @@ def _positions(is_move, close, setx, sety, ex, ey) -> np.ndarray:
     for setc, e in ((setx, ex), (sety, ey)):
         off, known = _group_offsets(is_move, close, setc, e)
         start = _start_chain(mv, setc, e, off, known)[grp]
-        out.append(np.where(known, off, start + off))
-    return out[0] + 1j * out[1]
+        start += off
+        out.append(np.where(known, off, start))
+        del off, known, start
+    return _complex(out.pop(0), out.pop())
+
+
+def _complex(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``x + 1j * y`` (the same values, signs of zero included) without complex temporaries."""
+    z = np.empty(x.size, dtype=complex)
+    re = y * 0.0  # the product 1j * y has the real part 0 * y - 0 and the imaginary part 0 + y
+    re -= 0.0
+    re += x
+    z.real = re
+    del re
+    np.add(y, 0.0, out=z.imag)
+    return z
 
 
 def _smooth_quads(t, op, p0, pts, is_move) -> np.ndarray:

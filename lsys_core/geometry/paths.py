@@ -47,6 +47,8 @@ MAX_COORD = 1e12
 DEFAULT_PRECISION = 9
 #: Segments written at once by :func:`d_from_cubics`.
 _WRITE_BLOCK = 1 << 15
+#: Rows turned into cubics at once by :func:`_elevate`.
+_ELEVATE_BLOCK = 1 << 16
 
 
 def _empty() -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
@@ -94,9 +96,13 @@ def assemble(paths: list[ArrayPath]) -> tuple[np.ndarray, np.ndarray, np.ndarray
 
 
 def _elevate(cubics: np.ndarray, kinds: np.ndarray) -> None:
-    """Turn line and quadratic rows (``p0 p0 p3 p3`` / ``p0 q q p3``) into exact cubics, in place."""
+    """Turn line and quadratic rows (``p0 p0 p3 p3`` / ``p0 q q p3``) into exact cubics, in place.
+
+    Works in blocks of :data:`_ELEVATE_BLOCK` rows: the temporaries stay a few MiB for any path.
+    """
     with np.errstate(invalid="ignore", over="ignore"):
-        _elevate_rows(cubics, kinds)
+        for lo in range(0, kinds.size, _ELEVATE_BLOCK):
+            _elevate_rows(cubics[lo : lo + _ELEVATE_BLOCK], kinds[lo : lo + _ELEVATE_BLOCK])
 
 
 def _elevate_rows(cubics: np.ndarray, kinds: np.ndarray) -> None:
@@ -222,9 +228,11 @@ def _convert(
         fill_arcs(cub, offset[curved], setup, pts[curved, 0], pts[curved, 3])
         seg_row = np.repeat(np.arange(n), slots)
     seg_sub = sub[seg_row]
+    del sub, keep
     change = np.ones(seg_sub.size, dtype=bool)
     change[1:] = seg_sub[1:] != seg_sub[:-1]  # subpath numbers never decrease: renumber the runs
-    subpaths = np.cumsum(change) - 1
+    subpaths = np.cumsum(change)
+    subpaths -= 1
     return cub, subpaths, closed_sub[seg_sub[change]].tolist(), table.path[seg_row]
 
 

@@ -231,14 +231,15 @@ def _placed(recs: list[ShapeRecord], counts: np.ndarray) -> tuple[np.ndarray, np
     """All records' cubics in document coordinates, which segments are usable, and their spread.
 
     Works in blocks of :data:`_BLOCK` segments, so a path of 10^6 segments needs a few MiB of
-    temporaries beside its cubics (one vectorised pass over all of them took about 300 MiB).
+    temporaries beside its cubics (one vectorised pass over all of them took about 300 MiB), and
+    in place when the records are the only users of their cubics (:func:`_joined`).
     Returns the cubics ``(K, 4)``, finite and within :data:`MAX_COORD` per segment, and every
     segment's largest distance from its record's first point.
     """
-    cubics = np.concatenate([r.path.cubics for r in recs])
+    first = np.array([r.path.cubics[0, 0] for r in recs], complex)
+    cubics = _joined(recs, counts)
     mats = np.array([r.ctm for r in recs], dtype=float)
     owner = np.repeat(np.arange(len(recs)), counts)
-    first = np.array([r.path.cubics[0, 0] for r in recs], complex)
     with np.errstate(invalid="ignore", over="ignore"):
         first = (mats[:, 0] * first.real + mats[:, 2] * first.imag + mats[:, 4]) + 1j * (
             mats[:, 1] * first.real + mats[:, 3] * first.imag + mats[:, 5]
@@ -255,6 +256,40 @@ def _placed(recs: list[ShapeRecord], counts: np.ndarray) -> tuple[np.ndarray, np
             ok[lo : lo + _BLOCK] = np.isfinite(block).all(axis=1) & (np.abs(block).max(axis=1) <= MAX_COORD)
             spread[lo : lo + _BLOCK] = np.abs(block - first[who, None]).max(axis=1)
     return cubics, ok, spread
+
+
+def _joined(recs: list[ShapeRecord], counts: np.ndarray) -> np.ndarray:
+    """The records' cubics one after another: their own array when they are views that tile it.
+
+    The path reader converts all paths of a document into one array; when the records hold
+    its pieces, in order, one each, and no other view of it exists (its reference count says
+    so: the reader has let go of its parsed paths), that array is the concatenation and is
+    placed in place, without a copy (61 MiB for a path of 10^6 segments).  The records' cubics
+    are not read again once placed (a hidden record may share a drawn one's piece).  Otherwise
+    the cubics are copied.
+    """
+    base = recs[0].path.cubics.base
+    if (
+        isinstance(base, np.ndarray)
+        and base.dtype == complex
+        and base.ndim == 2
+        and base.shape == (int(counts.sum()), 4)
+        and base.flags.c_contiguous
+        and base.flags.writeable
+        and sys.getrefcount(base) == len(recs) + 2  # one view per record, ``base``, the argument
+    ):
+        row = base.strides[0]
+        at = base.__array_interface__["data"][0]
+        tiles = True
+        for r, n in zip(recs, counts.tolist(), strict=True):
+            c = r.path.cubics
+            tiles = c.base is base and c.__array_interface__["data"][0] == at and c.flags.c_contiguous
+            if not tiles:
+                break
+            at += n * row
+        if tiles:
+            return base
+    return np.concatenate([r.path.cubics for r in recs])
 
 
 def _skip_messages(skips: Counter) -> list[str]:

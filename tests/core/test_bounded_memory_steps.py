@@ -76,3 +76,58 @@ def test_path_data_rounded_in_pieces_is_the_same():
     assert all(p[0].isalpha() for p in pieces)  # cut before command letters, never in a number
     assert "".join(compact._rounded(p, 2) for p in pieces) == compact._rounded(d, 2)
     assert compact._rounded("M-0.001 10.000 L 2.50 -3e-5 100 0.105", 2) == "M0 10 L 2.5 0 100 0.1"
+
+
+def test_same_segments_compared_in_blocks_are_the_same(monkeypatch):
+    rng = np.random.default_rng(5)
+    shapes = [_element(_ZIGZAG), _element("M0 0 L100 0 L100 100 L0 100 Z"), _element("M0 0 C 1 2 3 4 5 0")]
+    elements, which, a, b = [], [], [], []
+    for i in range(40):
+        s = i % 3
+        pose_a, pose_b = complex(*rng.normal(size=2)), complex(*rng.normal(size=2)) * 50
+        noise = (1e-9, 1e-3, 0.0, 2.0)[i % 4]
+        c = pose_a * shapes[s].cubics + pose_b + noise * rng.normal(size=shapes[s].cubics.shape)
+        if i % 7 == 0:
+            c = c[:-1]  # another number of segments: measured on polylines
+        elements.append(Element(c, np.zeros(c.shape[0], np.intp), (False,)))
+        which.append(s), a.append(pose_a), b.append(pose_b)
+    args = (elements, shapes, np.array(which), np.array(a), np.array(b), 1e-6)
+    whole, whole_todo = deviation._same_segments(*args)
+    assert 0 < whole_todo.size < len(elements) and (whole > 0).any()
+    for block in (1, 3, 400):
+        monkeypatch.setattr(deviation, "_SAME_BLOCK", block)
+        got, todo = deviation._same_segments(*args)
+        np.testing.assert_array_equal(todo, whole_todo)
+        assert got.tobytes() == whole.tobytes()
+
+
+def test_cubics_placed_in_place_or_copied_are_the_same(monkeypatch):
+    # Paths each drawn once are placed in their parsed array (a hidden copy shares the piece of
+    # the one drawn, and is not read again); a path drawn twice is copied first.  Either way the
+    # elements are the same.
+    in_place = []
+    joined = parse._joined
+
+    def spy(recs, counts):
+        got = joined(recs, counts)
+        in_place.append(got is recs[0].path.cubics.base)
+        return got
+
+    monkeypatch.setattr(parse, "_joined", spy)
+    zigzag = f'<path d="{_ZIGZAG}" transform="rotate(30) scale(2 1)"/>'
+    once = zigzag + '<path d="M 1 1 L 5 9"/>'
+    head = '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 500 500">'
+    bodies = (once, once + zigzag, once + f'<path d="{_ZIGZAG}" visibility="hidden"/>')
+    scenes = [parse_svg((head + body + "</svg>").encode()) for body in bodies]
+    assert in_place == [True, False, True]
+    assert [len(s.elements) for s in scenes] == [2, 3, 2]
+    for scene in scenes[1:]:
+        for a, b in zip(scene.elements, scenes[0].elements, strict=False):
+            np.testing.assert_array_equal(a.cubics, b.cubics)
+    np.testing.assert_array_equal(scenes[1].elements[2].cubics, scenes[0].elements[0].cubics)
+    alone = paths.path_from_d(_ZIGZAG)[0].cubics
+    c, s = np.cos(np.pi / 6), np.sin(np.pi / 6)
+    x, y = alone.real * 2, alone.imag
+    np.testing.assert_allclose(
+        scenes[0].elements[0].cubics, (c * x - s * y) + 1j * (s * x + c * y), atol=1e-9
+    )
