@@ -53,6 +53,8 @@ _SLACK = 0.02
 #: Cells per side of the distance fields of :func:`_apart_bounds`, and pairs bounded per block.
 _GRID = 64
 _BLOCK = 8192
+#: Every this many samples give the first, cheaper bound of :func:`_hopeless`.
+_COARSE_STRIDE = 8
 _QUARTERS = (1, 1j, -1, -1j)
 
 
@@ -104,7 +106,35 @@ def _apart(frames: _Frames, host: int, i: int, quarter: complex) -> float:
     return float(d.max()) - float(frames.gap[host]) - _SLACK
 
 
-def _apart_bounds(frames: _Frames, host: np.ndarray, other: np.ndarray) -> np.ndarray:
+@dataclass(frozen=True)
+class _Fields:
+    """Distance fields of sample sets on one grid (see :func:`_apart_bounds`)."""
+
+    field: np.ndarray  # (n, G * G) float32: each cell centre's distance to an occupied cell
+    reach: float  # the grid spans [-reach, reach] on both axes
+    step: float  # cell size
+
+    @classmethod
+    def of(cls, frames: _Frames) -> _Fields:
+        """The fields of all shapes of ``frames`` (one small transform per shape, not per pair)."""
+        reach = float(np.abs(frames.unit).max()) * 1.001 + 1e-9 if frames.unit.size else 1.0
+        out = cls(np.empty((frames.unit.shape[0], _GRID * _GRID), np.float32), reach, 2.0 * reach / _GRID)
+        for k, z in enumerate(frames.unit):
+            grid = np.ones((_GRID, _GRID), bool)
+            grid[out.cell(z)] = False
+            out.field[k] = distance_transform_edt(grid, sampling=out.step).ravel()
+        return out
+
+    def cell(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Column and row of the cells of points ``z`` (clipped to the grid)."""
+        ix = np.clip(np.floor((z.real + self.reach) / self.step).astype(np.int64), 0, _GRID - 1)
+        iy = np.clip(np.floor((z.imag + self.reach) / self.step).astype(np.int64), 0, _GRID - 1)
+        return ix, iy
+
+
+def _apart_bounds(
+    frames: _Frames, fields: _Fields, host: np.ndarray, other: np.ndarray, stride: int = 1
+) -> np.ndarray:
     """Lower bounds of :func:`_apart` for the pairs ``(host[k], other[k])`` and each quarter turn.
 
     Every unit-frame sample set is rasterised on one grid covering all samples; the Euclidean
@@ -112,7 +142,8 @@ def _apart_bounds(frames: _Frames, host: np.ndarray, other: np.ndarray) -> np.nd
     anywhere in its cell), bounds from below the distance of a cell's centre to the host's
     samples, and less the distance to that centre it bounds the distance of any point of the
     cell (the distance is 1-Lipschitz).  The largest bound over the other shape's samples,
-    less the host's half spacing and :data:`_SLACK`, is at most :func:`_apart`.
+    less the host's half spacing and :data:`_SLACK`, is at most :func:`_apart`.  Taken over every
+    ``stride``-th sample only, the bound is cheaper and weaker, and still a lower bound.
 
     Returns
     -------
@@ -120,43 +151,32 @@ def _apart_bounds(frames: _Frames, host: np.ndarray, other: np.ndarray) -> np.nd
         One bound per quarter turn of :data:`_QUARTERS`; ``-inf`` where :func:`_apart` gives no
         bound (a host of several subpaths).
     """
-    unit = frames.unit
     out = np.full((host.size, len(_QUARTERS)), -np.inf)
-    finite = np.isfinite(frames.gap[host])
-    if not finite.any():
-        return out
-    hosts, slot = np.unique(host[finite], return_inverse=True)
-    reach = float(np.abs(unit[np.unique(np.concatenate([hosts, other[finite]]))]).max()) * 1.001 + 1e-9
-    step = 2.0 * reach / _GRID
-    centres = -reach + (np.arange(_GRID) + 0.5) * step
-
-    def cell(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        ix = np.clip(np.floor((z.real + reach) / step).astype(np.int64), 0, _GRID - 1)
-        iy = np.clip(np.floor((z.imag + reach) / step).astype(np.int64), 0, _GRID - 1)
-        return ix, iy
-
-    field = np.empty((hosts.size, _GRID * _GRID), np.float32)
-    for k, h in enumerate(hosts.tolist()):  # one small transform per shape, not per pair
-        grid = np.ones((_GRID, _GRID), bool)
-        grid[cell(unit[h])] = False
-        field[k] = distance_transform_edt(grid, sampling=step).ravel()
-    half_cell = step * np.sqrt(0.5)
-    rows = np.flatnonzero(finite)
+    rows = np.flatnonzero(np.isfinite(frames.gap[host]))
+    half = (np.arange(_GRID) + 0.5) * fields.step - fields.reach  # cell centres along an axis
+    half_cell = fields.step * np.sqrt(0.5)
     for lo in range(0, rows.size, _BLOCK):
         sel = rows[lo : lo + _BLOCK]
-        fk = slot[lo : lo + _BLOCK, None]
-        u = unit[other[sel]]
+        fk = host[sel, None]
+        u = frames.unit[other[sel], ::stride]
         for j, q in enumerate(_QUARTERS):
             x = u * np.conj(q)  # |u - q v| = |conj(q) u - v|
-            ix, iy = cell(x)
-            near = field[fk, ix * _GRID + iy].astype(float)
-            off = np.abs(x - (centres[ix] + 1j * centres[iy]))
+            ix, iy = fields.cell(x)
+            near = fields.field[fk, ix * _GRID + iy].astype(float)
+            off = np.abs(x - (half[ix] + 1j * half[iy]))
             out[sel, j] = (near - half_cell - off).max(axis=1)
     out[rows] -= (frames.gap[host[rows]] + _SLACK + 1e-5)[:, None]  # 1e-5: float32 field, rounding
     return out
 
 
-def _hopeless(frames, drawable, inst, pairs, rank, tolerance) -> np.ndarray:
+def _hopeless(
+    frames: _Frames,
+    drawable: np.ndarray,
+    inst: Instancing,
+    pairs: np.ndarray,
+    rank: np.ndarray,
+    tolerance: float,
+) -> np.ndarray:
     """Which pairs ``(host, i)`` no quarter turn can merge, by :func:`_apart_bounds`.
 
     :func:`_aligned` skips a quarter turn when ``apart * drawn - dev > limit`` for one of the
@@ -172,14 +192,19 @@ def _hopeless(frames, drawable, inst, pairs, rank, tolerance) -> np.ndarray:
     inside = member >= 0
     drawn = np.abs(inst.a[inside]) * frames.radius[member[inside]]
     limit = np.minimum(MERGE_RELATIVE * drawn, MERGE_SHARE * tolerance)
+    dev = inst.deviation if inst.deviation is not None else np.zeros(inst.group.size)
     with np.errstate(all="ignore"):
-        ratio = (limit + inst.deviation[inside]) / drawn
+        ratio = (limit + dev[inside]) / drawn
     ratio = np.where((drawn > 0) & ~np.isnan(ratio), ratio, np.inf)
     thr = np.full(drawable.size, np.inf)
     np.minimum.at(thr, member[inside], ratio)
-    bound = _apart_bounds(frames, host, other)
     t = thr[other][:, None]
-    return (bound > t + 1e-9 * (1.0 + np.abs(t))).all(axis=1)
+    t = t + 1e-9 * (1.0 + np.abs(t))
+    fields = _Fields.of(frames)
+    out = (_apart_bounds(frames, fields, host, other, _COARSE_STRIDE) > t).all(axis=1)  # most pairs end here
+    rest = np.flatnonzero(~out)
+    out[rest] = (_apart_bounds(frames, fields, host[rest], other[rest]) > t[rest]).all(axis=1)
+    return out
 
 
 def merge_within(scene: Scene, inst: Instancing, tolerance: float) -> Instancing:

@@ -40,8 +40,8 @@ def _element(cubics: np.ndarray) -> Element:
 
 
 @settings(max_examples=25, deadline=None)
-@given(st.integers(0, 2**32 - 1), st.sampled_from([0.0, 0.003, 0.01, 0.05]))
-def test_bound_is_below_the_exact_lower_bound(seed: int, jitter: float) -> None:
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.0, 0.003, 0.01, 0.05]), st.sampled_from([1, 8]))
+def test_bound_is_below_the_exact_lower_bound(seed: int, jitter: float, stride: int) -> None:
     """For random shapes and their moved, turned, scaled, mirrored and jittered copies, every quarter turn."""
     rng = np.random.default_rng(seed)
     base = [_polygon(rng) for _ in range(6)]
@@ -49,9 +49,12 @@ def test_bound_is_below_the_exact_lower_bound(seed: int, jitter: float) -> None:
     frames = merge._frames([_element(s) for s in shapes])
     host, other = np.triu_indices(len(shapes), 1)
     host, other = np.concatenate([host, other]), np.concatenate([other, host])
-    bound = merge._apart_bounds(frames, host, other)
+    bound = merge._apart_bounds(frames, merge._Fields.of(frames), host, other, stride)
     exact = np.array(
-        [[merge._apart(frames, int(h), int(o), q) for q in merge._QUARTERS] for h, o in zip(host, other, strict=True)]
+        [
+            [merge._apart(frames, int(h), int(o), q) for q in merge._QUARTERS]
+            for h, o in zip(host, other, strict=True)
+        ]
     )
     assert (bound <= exact).all(), float((bound - exact).max())
     # not vacuous: distinct shapes are told apart by the bound alone
