@@ -17,6 +17,8 @@ from lsys_core import parallel
 
 __all__ = ["group_indices", "mean_shift"]
 
+#: Up to this many points, the labels come from one KD-tree query (cheaper than per-cell reasoning).
+_DIRECT = 20_000
 #: Points binned at once.
 _BLOCK = 1 << 18
 #: Neighbours asked of the KD-tree per seed before falling back to a ball query.
@@ -140,6 +142,45 @@ def _support(
     return support
 
 
+def _nearest_mode(pts: np.ndarray, modes: np.ndarray, cent: np.ndarray, inv: np.ndarray) -> np.ndarray:
+    """The nearest of ``modes`` within a bandwidth of every point (-1: none), decided per cell.
+
+    Every point of cell ``c`` lies within ``R_c`` (measured) of its centroid, so only modes within
+    ``1 + R_c`` of the centroid can be within a bandwidth of it.  A cell with one such mode labels
+    its points by their distance to that mode alone, a cell with none labels them -1; only the
+    points of the other cells go through the KD-tree.  The labels are those of one KD-tree query
+    of all points: of the 5·10^6 consecutive pairs of a 50,000-leaf grid, none needed the tree
+    (1.8 -> 0.3 s of CPU).
+    """
+    if len(pts) <= _DIRECT:
+        dist, idx = cKDTree(modes).query(pts, k=1)
+        return np.where(dist <= 1.0, idx, -1)
+    reach = np.zeros(len(cent))
+    for lo in range(0, len(pts), _BLOCK):  # in blocks: temporaries of the size of the points
+        sl = slice(lo, lo + _BLOCK)
+        np.maximum.at(reach, inv[sl], _dist(pts[sl], cent[inv[sl]]))
+    tree = cKDTree(modes)
+    near = tree.query_ball_point(cent, reach + (1.0 + 1e-9), return_sorted=False)
+    only = np.fromiter((x[0] if len(x) == 1 else -len(x) for x in near), np.int64, len(near))
+    lab = np.full(len(pts), -1, np.int64)
+    for lo in range(0, len(pts), _BLOCK):
+        m = only[inv[lo : lo + _BLOCK]]
+        one = np.flatnonzero(m >= 0)
+        inside = _dist(pts[lo + one], modes[m[one]]) <= 1.0
+        lab[lo + one[inside]] = m[one[inside]]
+        many = np.flatnonzero(m <= -2)
+        if many.size:
+            dist, idx = tree.query(pts[lo + many], k=1)
+            lab[lo + many] = np.where(dist <= 1.0, idx, -1)
+    return lab
+
+
+def _dist(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Row-wise Euclidean distances."""
+    d = p - q
+    return np.sqrt(np.einsum("ij,ij->i", d, d))
+
+
 def mean_shift(
     points: np.ndarray, *, max_iter: int = 30, min_count: int = 1
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -171,11 +212,13 @@ def mean_shift(
     keys = np.concatenate(
         [_row_keys(np.floor(pts[lo : lo + _BLOCK] * 2.0).astype(np.int64)) for lo in range(0, n, _BLOCK)]
     )  # in blocks: three temporaries of the size of the points for 6·10^6 points were 0.7 GiB
-    _, inv, counts = np.unique(keys, return_inverse=True, return_counts=True)
+    cells = np.unique(keys)  # a plain sort: ``return_inverse`` sorts indices, 2.3x slower at 5·10^6
+    inv = np.searchsorted(cells, keys)
     del keys
-    inv = inv.ravel()
-    cent = np.zeros((counts.size, pts.shape[1]))
-    np.add.at(cent, inv, pts)
+    counts = np.bincount(inv, minlength=cells.size)
+    cent = np.column_stack(
+        [np.bincount(inv, weights=pts[:, k], minlength=cells.size) for k in range(pts.shape[1])]
+    )
     cent /= counts[:, None]
     w = counts.astype(float)
     tree = cKDTree(cent)
@@ -209,8 +252,7 @@ def mean_shift(
     if not keep_idx.size:
         return np.full(n, -1), np.zeros((0, pts.shape[1]))
     mode_arr = seeds[keep_idx]
-    dist, lab = cKDTree(mode_arr).query(pts, k=1)
-    lab = np.where(dist <= 1.0, lab, -1)
+    lab = _nearest_mode(pts, mode_arr, cent, inv)
     # Points farther than a bandwidth from every mode form their own singleton clusters.
     lone = np.flatnonzero(lab < 0)
     if lone.size:

@@ -8,8 +8,11 @@ pairs in the (d, s) subspace, then the differences of consecutive pairs' turns.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
+from lsys_core import parallel
 from lsys_core.geometry.transforms import wrap_deg
 from lsys_core.hierarchy.candidates import Context, LinearCandidate
 from lsys_core.hierarchy.chains import edge_groups, successor_pairs
@@ -22,6 +25,8 @@ __all__ = ["linear_candidates"]
 
 #: Step clusters (Δα, Δβ) examined per (d, s) cluster, largest first: smaller ones cannot win.
 _STEP_CLUSTERS = 12
+#: Consecutive pairs from which the chains of the step clusters are solved on several threads.
+_SPLIT = 200_000
 
 
 def linear_candidates(
@@ -82,7 +87,25 @@ def linear_candidates(
             continue  # constant transform: a cluster C already covers it
         problems.append((e1[g2], e2[g2], dA, dB))
     del emb2, lab2, e1, e2, cluster, da, db  # millions of consecutive pairs at 50,000 elements
-    return _linear_chains(ctx, sym, ps, problems, prox)
+    batches = _batches([p[0].size for p in problems], parallel.jobs())
+    solved = parallel.pmap(lambda b: _linear_chains(ctx, sym, ps, problems[b[0] : b[1]], prox), batches)
+    return [c for part in solved for c in part]
+
+
+def _batches(sizes: list[int], workers: int) -> list[tuple[int, int]]:
+    """Split problems of these sizes into ≤ ``workers`` runs of about equal total size, in order.
+
+    The problems are independent (:func:`_linear_chains` solves each on its own keys), so the
+    runs can be solved on separate threads and their candidates concatenated in order: the
+    result does not depend on the number of workers.  Small inputs stay in one run.
+    """
+    total = sum(sizes)
+    if workers <= 1 or total < _SPLIT or len(sizes) < 2:
+        return [(0, len(sizes))]
+    cum = np.cumsum(sizes)
+    cuts = np.searchsorted(cum, total * np.arange(1, workers) / workers)
+    bounds = sorted({0, len(sizes), *(int(c) + 1 for c in cuts if 0 <= c < len(sizes) - 1)})
+    return list(itertools.pairwise(bounds))
 
 
 def _promising(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import os
 import subprocess
 import sys
@@ -98,6 +99,33 @@ def test_linear_sequences_taking_turns_give_the_same_rules(restore_jobs, monkeyp
     beside = format_grammar(infer(grid).grammar)
     monkeypatch.setattr(analysis, "BESIDE_PAIRS", 0)  # as a scene of millions of pairs does
     assert format_grammar(infer(grid).grammar) == beside
+
+
+def test_step_clusters_solved_in_batches_give_the_same_rules(restore_jobs, monkeypatch) -> None:
+    from lsys_core.hierarchy import linear
+
+    grid = _rotating_grid(6, 9)
+    parallel.set_jobs(1)
+    whole = infer(grid)
+    split = []
+    batches = linear._batches
+    monkeypatch.setattr(linear, "_SPLIT", 0)  # as a scene of millions of consecutive pairs does
+    monkeypatch.setattr(linear, "_batches", lambda *a: split.append(batches(*a)) or split[-1])
+    parallel.set_jobs(3)
+    parts = infer(grid)
+    assert max(len(b) for b in split) >= 2
+    assert format_grammar(parts.grammar) == format_grammar(whole.grammar) and parts.log == whole.log
+
+
+def test_batches_cover_every_problem_once_in_order() -> None:
+    from lsys_core.hierarchy.linear import _batches
+
+    assert _batches([5, 5], 1) == [(0, 2)]
+    for sizes in ([300_000] * 5, [1, 900_000, 1, 1], [400_000, 1]):
+        for workers in (2, 3, 8):
+            runs = _batches(sizes, workers)
+            assert runs[0][0] == 0 and runs[-1][1] == len(sizes) and len(runs) <= workers
+            assert all(a < b for a, b in runs) and all(x[1] == y[0] for x, y in itertools.pairwise(runs))
 
 
 def test_mean_shift_binned_in_blocks_is_the_same(monkeypatch) -> None:
