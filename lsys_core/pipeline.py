@@ -27,6 +27,7 @@ from lsys_core.hierarchy.postprocess import simplify
 from lsys_core.hierarchy.rules import Hierarchy, Tolerance, Weights, build_hierarchy
 from lsys_core.hierarchy.snap import SHARE
 from lsys_core.instancing.fidelity import split_unfaithful
+from lsys_core.instancing.halfturn import turn_near_symmetric
 from lsys_core.instancing.merge import merge_within
 from lsys_core.instancing.model import Instancing, terminal_shapes
 from lsys_core.instancing.orientation import ring_headings, unwrap_symmetric
@@ -105,6 +106,7 @@ def _instancing(scene: Scene, settings: InferenceSettings, tolerance: float, can
     inst = split_unfaithful(scene, inst, tolerance=tolerance, threshold=settings.similarity, cancel=cancel)
     inst = merge_within(scene, inst, tolerance)
     inst = regular_scales(scene, medoids(scene, inst, tolerance), tolerance)
+    inst = turn_near_symmetric(scene, inst, tolerance)
     inst = round_within(terminal_shapes(inst), inst, tolerance)
     inst = merge_round(scene.elements, terminal_shapes(inst), inst, tolerance)
     return stretch_families(scene, inst, tolerance)

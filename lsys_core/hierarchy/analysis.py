@@ -66,14 +66,14 @@ def find_candidates(
     size = np.maximum(ctx.sizes()[sym[ps.src]], 1e-9)
     key = space_key(sym, ps)
     th = np.angle(ps.A)
-    ang = np.deg2rad(tol.angle)
+    xy, ang, scale = _bandwidths(tol, size, ps, ledger)
     emb = np.column_stack(
         [
-            ps.B.real / (tol.xy * size),
-            ps.B.imag / (tol.xy * size),
+            ps.B.real / xy,
+            ps.B.imag / xy,
             np.cos(th) / ang,
             np.sin(th) / ang,
-            np.log(np.abs(ps.A)) / tol.scale,
+            np.log(np.abs(ps.A)) / scale,
             key * 1e7,
         ]
     )
@@ -124,6 +124,49 @@ def find_candidates(
     out += branch_candidates(ps, same, prox, n_nodes)
     out += linear.result() if linear is not None else linear_candidates(ctx, sym, ps, prox, size, key, ledger)
     return out
+
+
+#: The widest turn (radians) and log-scale the tolerance floor lets the clustering ignore.
+_FLOOR_CAP = np.pi / 8
+#: A pair whose nodes already deviate by this share of the tolerance (together) is measured
+#: with the whole floor; pairs of copies closer to their terminal with a part of it.
+_NOISE = 4.0
+
+
+def _bandwidths(
+    tol, size: np.ndarray, ps: PairSpace, ledger: Ledger | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Bandwidths of every pair's translation, turn (radians) and log-scale.
+
+    The paper's bandwidths are relative to the size of the shapes (§5.3), but the noise of
+    copies drawn by hand is absolute: a dot 6 units wide drawn 10 % larger and 0.2 units off
+    its place moves its step by a tenth of its size.  Such copies show it: their outlines
+    deviate from their terminal's (the tolerance their node has left, ``slack``, is smaller).
+    A pair of symbols whose nodes deviate by ``d1`` and ``d2`` on average is measured with that
+    noise: the translation bandwidth is at least ``tol.length·min(eps, 4·(d1 + d2))``
+    (:data:`_NOISE`), and turns and scale changes that move the source's outline by as little
+    are not told apart either.  The floor is one per pair of symbols, in the source symbol's
+    typical frame: within one space every pair is measured in the same units (mean shift
+    needs that; a spiral's steps are constant in their own frames).  The relaxed tries of the
+    pipeline scale ``tol.length`` with the other bandwidths.  Exact
+    copies keep the paper's bandwidths; without a ledger (no precision), so does every pair.
+    """
+    xy = tol.xy * size
+    ang = np.full(size.shape, np.deg2rad(tol.angle))
+    scale = np.full(size.shape, float(tol.scale))
+    if ledger is None or tol.length <= 0.0:
+        return xy, ang, scale
+    eps, nodes = ledger.prec.eps, ledger.nodes
+    # per symbol (so that one space is measured in one unit): the mean deviation of its nodes'
+    # outlines, and their typical scale (the pairs' transforms are in their source's frame)
+    noise = np.clip(eps - nodes.slack, 0.0, eps)
+    count = np.maximum(np.bincount(nodes.sym), 1)
+    noise = np.bincount(nodes.sym, noise) / count
+    scale_of = np.exp(np.bincount(nodes.sym, np.log(np.maximum(np.abs(nodes.a), 1e-300))) / count)
+    si, sj = nodes.sym[ps.src], nodes.sym[ps.dst]
+    floor = tol.length * np.minimum(_NOISE * (noise[si] + noise[sj]), eps) / scale_of[si]
+    turn = np.minimum(floor / size, _FLOOR_CAP)
+    return np.maximum(xy, floor), np.maximum(ang, turn), np.maximum(scale, turn)
 
 
 def _alternation_length(succ: dict[int, int], back_clusters: list[ConstantCluster]) -> float:

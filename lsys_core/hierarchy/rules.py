@@ -47,15 +47,21 @@ DEFAULT_TOLERANCE = 0.005
 
 @dataclass(frozen=True)
 class Tolerance:
-    """Clustering bandwidths: translation relative to the symbol's size, angle (degrees), log-scale."""
+    """Clustering bandwidths: translation relative to the symbol's size, angle (degrees), log-scale.
+
+    ``length`` is a floor of all three, as a share of the tolerance ``eps`` (a length in the
+    drawing): transforms that move a node's outline by less than ``length·eps`` are not told
+    apart, however small the shape (see :func:`~lsys_core.hierarchy.analysis.find_candidates`).
+    """
 
     xy: float = 0.02
     angle: float = 1.0
     scale: float = 0.01
+    length: float = 0.5
 
     def scaled(self, factor: float) -> Tolerance:
         """Return the bandwidths multiplied by ``factor``."""
-        return Tolerance(self.xy * factor, self.angle * factor, self.scale * factor)
+        return Tolerance(self.xy * factor, self.angle * factor, self.scale * factor, self.length * factor)
 
 
 @dataclass(frozen=True, eq=False)

@@ -33,7 +33,7 @@ from lsys_core.instancing.model import Instancing, terminal_shapes
 from lsys_core.instancing.sampling import arc_fractions, sample_elements
 from lsys_core.svg.model import Element, Scene
 
-__all__ = ["MERGE_RELATIVE", "MERGE_SHARE", "SAME_SIZE", "merge_within", "without_groups"]
+__all__ = ["MERGE_RELATIVE", "MERGE_SHARE", "SAME_SIZE", "UNTOLD", "merge_within", "without_groups"]
 
 #: Share of the tolerance a merged instance may deviate from its new terminal (the rest is left
 #: to the rules' placements).
@@ -43,6 +43,9 @@ MERGE_SHARE = 0.5
 MERGE_RELATIVE = 0.1
 #: Largest relative difference in size (RMS radius as drawn) between a merged instance and its host's.
 SAME_SIZE = 0.15
+#: Share of the tolerance by which two readings of one drawing (turned or mirrored) must differ
+#: to be told apart: a copy that fits its other reading as well within it is taken either way.
+UNTOLD = 0.1
 #: Samples per outline for the alignment frames.
 _SAMPLES = 96
 #: Largest difference of descriptors (anisotropy; length over radius, scaled) between shapes tried.
@@ -132,8 +135,30 @@ class _Fields:
         return ix, iy
 
 
+def _upright(frames: _Frames, host, i):
+    """The turn of the unit frames that aligns the terminals as drawn (not by their principal axes)."""
+    return frames.axis[host] / frames.axis[i]
+
+
+def _turns(frames: _Frames, host: int, i: int) -> list[complex]:
+    """The turns of the unit frames tried: the quarter turns of the principal axes, and of the
+    terminals as drawn.  The axes of a nearly square outline are ill-defined (a window drawn by
+    hand: 6° off); the frames of two copies drawn upright are not.
+    """
+    upright = complex(_upright(frames, host, i))
+    turns = list(_QUARTERS)
+    if abs(upright - 1.0) > 1e-3:
+        turns += [q * upright for q in _QUARTERS]
+    return turns
+
+
 def _apart_bounds(
-    frames: _Frames, fields: _Fields, host: np.ndarray, other: np.ndarray, stride: int = 1
+    frames: _Frames,
+    fields: _Fields,
+    host: np.ndarray,
+    other: np.ndarray,
+    stride: int = 1,
+    turn: np.ndarray | None = None,
 ) -> np.ndarray:
     """Lower bounds of :func:`_apart` for the pairs ``(host[k], other[k])`` and each quarter turn.
 
@@ -144,6 +169,8 @@ def _apart_bounds(
     cell (the distance is 1-Lipschitz).  The largest bound over the other shape's samples,
     less the host's half spacing and :data:`_SLACK`, is at most :func:`_apart`.  Taken over every
     ``stride``-th sample only, the bound is cheaper and weaker, and still a lower bound.
+    ``turn`` (one unit complex per pair) turns every quarter turn further (the upright frames
+    of :func:`_turns`).
 
     Returns
     -------
@@ -159,8 +186,9 @@ def _apart_bounds(
         sel = rows[lo : lo + _BLOCK]
         fk = host[sel, None]
         u = frames.unit[other[sel], ::stride]
+        extra = 1.0 if turn is None else turn[sel, None]
         for j, q in enumerate(_QUARTERS):
-            x = u * np.conj(q)  # |u - q v| = |conj(q) u - v|
+            x = u * np.conj(q * extra)  # |u - q v| = |conj(q) u - v|
             ix, iy = fields.cell(x)
             near = fields.field[fk, ix * _GRID + iy].astype(float)
             off = np.abs(x - (half[ix] + 1j * half[iy]))
@@ -201,9 +229,15 @@ def _hopeless(
     t = thr[other][:, None]
     t = t + 1e-9 * (1.0 + np.abs(t))
     fields = _Fields.of(frames)
-    out = (_apart_bounds(frames, fields, host, other, _COARSE_STRIDE) > t).all(axis=1)  # most pairs end here
-    rest = np.flatnonzero(~out)
-    out[rest] = (_apart_bounds(frames, fields, host[rest], other[rest]) > t[rest]).all(axis=1)
+    upright = _upright(frames, host, other)
+    out = np.ones(host.size, bool)
+    for turn in (None, upright):  # the turns of _turns: the principal axes', then the upright frames'
+        rest = np.flatnonzero(out)
+        spin = None if turn is None else turn[rest]
+        bound = _apart_bounds(frames, fields, host[rest], other[rest], _COARSE_STRIDE, spin)
+        keep = ~(bound > t[rest]).all(axis=1)  # most pairs end at the coarse bound
+        rest, spin = rest[keep], None if spin is None else spin[keep]
+        out[rest] = (_apart_bounds(frames, fields, host[rest], other[rest], 1, spin) > t[rest]).all(axis=1)
     return out
 
 
@@ -211,7 +245,8 @@ def merge_within(scene: Scene, inst: Instancing, tolerance: float) -> Instancing
     """Return ``inst`` with groups merged whose instances another group's terminal draws within ``tolerance``.
 
     Terminals are aligned by their outlines' centroids, RMS radii and principal axes (each
-    of the four quarter turns tried, no mirror images), proposed only when their
+    of the four quarter turns tried, and the terminals' own frames; never flipped: a group of
+    mirror images joins only when its shape is symmetric within the tolerance), proposed only when their
     descriptors are close (:func:`_frames`); a group joins the larger one whose terminal,
     so aligned, draws every one of its instances within the tolerance.
 
@@ -265,13 +300,26 @@ def merge_within(scene: Scene, inst: Instancing, tolerance: float) -> Instancing
         own = float(sizes[host])  # the host's size as drawn (its members have not moved yet)
         for i in sorted(near.get(host, []), key=lambda k: rank[k]):
             h = int(drawable[i])
-            if h in gone or rank[i] < rank[host] or g in (inst.mirrored_of[h], h) or inst.mirrored_of[g] == h:
-                continue  # a mirror image is kept as one (the flips of §5.4)
+            if h in gone or rank[i] < rank[host] or g == h:
+                continue
+            # A mirror image (the flips of §5.4) is tried as well, turned but not flipped, and
+            # joins only when its drawing does not tell the two readings apart (UNTOLD): a
+            # window drawn by hand, not the exact mirror image of a nearly symmetric leaf.
+            flipped = g == inst.mirrored_of[h] or inst.mirrored_of[g] == h
             members = np.flatnonzero(group == h)
             size = np.abs(a[members]) * r[i]
             if not (own > 0.0 and r[i] > 0.0) or np.abs(size / own - 1.0).max() > SAME_SIZE:
                 continue  # copies are drawn at one size; a shape like another at another size is not its copy
-            pose = _aligned(scene, shapes[g], members, a, b, dev, frames, host, i, MERGE_SHARE * tolerance)
+            pose = _aligned(
+                scene,
+                shapes[g],
+                members,
+                (a, b, dev),
+                frames,
+                (host, i),
+                MERGE_SHARE * tolerance,
+                UNTOLD * tolerance if flipped else np.inf,
+            )
             if pose is None:
                 continue
             members, pa, pb, d = pose
@@ -287,26 +335,30 @@ def _aligned(
     scene: Scene,
     shape: Element,
     members: np.ndarray,
-    a: np.ndarray,
-    b: np.ndarray,
-    dev: np.ndarray,
+    poses: tuple[np.ndarray, np.ndarray, np.ndarray],
     frames: _Frames,
-    host: int,
-    i: int,
+    pair: tuple[int, int],
     tolerance: float,
+    untold: float = np.inf,
 ):
     """Poses of ``shape`` over the elements ``members`` (terminal ``i``'s instances), if all within ``tolerance``.
 
-    Returns ``(members, a, b, deviations)`` for the quarter turn of the principal axes that
-    fits best, or None.  A quarter turn whose lower bound (:func:`_apart`, less each member's
-    own deviation from terminal ``i``) already exceeds a member's limit is not measured.
+    ``poses`` are every element's pose and deviation ``(a, b, dev)``; ``pair`` is ``(host, i)``,
+    the frames of the host's terminal and of the members'.  Returns ``(members, a, b,
+    deviations)`` for the quarter turn of the principal axes (or of the terminals' own frames)
+    that fits best, or None.  A member may deviate by at most ``untold`` more than it did
+    from its own terminal (a mirror image joins only when its drawing cannot tell).  A quarter
+    turn whose lower bound (:func:`_apart`, less each member's own deviation from terminal
+    ``i``) already exceeds a member's limit is not measured.
     """
+    a, b, dev = poses
+    host, i = pair
     c, r, axis = frames.centre, frames.radius, frames.axis
     elements = [scene.elements[int(j)] for j in members]
     drawn = np.abs(a[members]) * r[i]  # each member's radius as drawn
-    limit = np.minimum(MERGE_RELATIVE * drawn, tolerance)
+    limit = np.minimum(np.minimum(MERGE_RELATIVE * drawn, tolerance), dev[members] + untold)
     best = None
-    for quarter in _QUARTERS:
+    for quarter in _turns(frames, host, i):
         if (_apart(frames, host, i, quarter) * drawn - dev[members] > limit).any():
             continue
         rel_a = r[i] / r[host] * axis[i] / axis[host] * quarter
@@ -316,6 +368,7 @@ def _aligned(
         if (
             (d <= MERGE_RELATIVE * np.abs(pa) * r[host]).all()
             and d.max() <= tolerance
+            and (d <= dev[members] + untold).all()
             and (best is None or d.max() < best[3].max())
         ):
             best = (members, pa, pb, d)

@@ -20,10 +20,10 @@ from scipy.spatial import cKDTree
 
 from lsys_core.instancing.model import Instancing
 
-__all__ = ["ring_headings", "unwrap_symmetric"]
+__all__ = ["ring_headings", "unwrap_symmetric", "unwrap_turns"]
 
 
-def _unwrap_group(a: np.ndarray, b: np.ndarray, period: float) -> np.ndarray:
+def unwrap_turns(a: np.ndarray, b: np.ndarray, period: float) -> np.ndarray:
     """Return the rotations (radians) of one group's instances, unwrapped along an MST."""
     n = a.size
     theta = np.angle(a)
@@ -58,7 +58,7 @@ def unwrap_symmetric(inst: Instancing) -> Instancing:
         sel = np.flatnonzero(inst.group == g)
         if sel.size < 2:
             continue
-        theta = _unwrap_group(inst.a[sel], inst.b[sel], 2 * np.pi / order)
+        theta = unwrap_turns(inst.a[sel], inst.b[sel], 2 * np.pi / order)
         a[sel] = np.abs(inst.a[sel]) * np.exp(1j * theta)
     return replace(inst, a=a)
 

@@ -87,3 +87,21 @@ def test_plainer_leaves_a_collapsing_transform_alone():
             kind(space=(0, 0), groups=groups, h=1.0, phi=1.0, l=0.5, A=complex(0.9999, 0.001), B=1 + 0j)
         )
         assert step is not None and step.A == 1.0
+
+
+def test_plainer_puts_a_step_a_degree_off_on_its_axis():
+    """Copies placed by hand in a row measure a step a degree off the row's axis: the plain step lies on it."""
+    import numpy as np
+
+    from lsys_core.hierarchy.candidates import SeqCandidate
+    from lsys_core.hierarchy.snap import plainer
+
+    groups = (np.array([0, 1, 2]),)
+    for step, axis in ((4.699 + 0.082j, 4.699), (-0.05 - 9.0j, -9.0j)):
+        c = SeqCandidate(space=(0, 0), groups=groups, h=1.0, phi=1.0, l=2.0, A=1 + 0j, B=step)
+        plain = plainer(c)
+        assert plain is not None and plain.A == 1.0
+        assert abs(plain.B - abs(step) * axis / abs(axis)) < 1e-12
+        assert (plain.B.real == 0.0) or (plain.B.imag == 0.0)  # one number fewer to write
+    off = SeqCandidate(space=(0, 0), groups=groups, h=1.0, phi=1.0, l=2.0, A=1 + 0j, B=4.0 + 1.0j)
+    assert plainer(off) is None  # 14° off: a slanted row, not a jittered one
