@@ -26,6 +26,7 @@ __all__ = [
     "arrays_from_table",
     "assemble",
     "collinear_thirds",
+    "consecutive",
     "cubics_from_d",
     "cubics_from_table",
     "d_from_cubics",
@@ -236,6 +237,31 @@ def _convert(
     return cub, subpaths, closed_sub[seg_sub[change]].tolist(), table.path[seg_row]
 
 
+def consecutive(arrays: list[np.ndarray]) -> np.ndarray | None:
+    """The arrays one after another as a view, when they are consecutive pieces of one array.
+
+    ``arrays`` are ``(k, 4)`` arrays (the elements of a scene are pieces of the array the reader
+    placed them in); returns the view of the array that owns their memory that they tile, in
+    order (empty ones aside), or None (then :func:`numpy.concatenate` is the way to join them).
+    """
+    full = [c for c in arrays if c.shape[0]]
+    if not full:
+        return None
+    owner = full[0] if full[0].base is None else full[0].base
+    if not isinstance(owner, np.ndarray) or not owner.flags.c_contiguous:
+        return None
+    size = owner.itemsize
+    origin = owner.__array_interface__["data"][0]
+    lo = at = full[0].__array_interface__["data"][0]
+    for c in full:
+        mine = c if c.base is None else c.base
+        same = mine is owner and c.dtype == owner.dtype and c.ndim == 2 and c.shape[1] == 4
+        if not same or not c.flags.c_contiguous or c.__array_interface__["data"][0] != at:
+            return None
+        at += c.nbytes
+    return owner.reshape(-1)[(lo - origin) // size : (at - origin) // size].reshape(-1, 4)
+
+
 def cubics_from_d(d: str) -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
     """Parse SVG path data into cubic arrays (see :func:`cubics_from_table`).
 
@@ -298,10 +324,9 @@ def d_from_cubics(
     if k == 0:
         return ""
     subpaths = np.zeros(k, dtype=np.intp) if subpaths is None else np.asarray(subpaths).reshape(k)
-    scale = float(np.max(np.abs(cubics))) or 1.0
+    blocks = [slice(lo, lo + _WRITE_BLOCK) for lo in range(0, k, _WRITE_BLOCK)]
+    scale = float(np.max([np.abs(cubics[part]).max() for part in blocks])) or 1.0
     tol = 1e-9 * scale
-    xy = np.stack([cubics.real, cubics.imag], axis=-1) + 0.0  # (k, 4, 2); + 0.0 turns -0.0 into 0.0
-    xy[np.abs(xy) < 1e-12 * scale] = 0.0
 
     p_start = cubics[:, 0]
     first = np.ones(k, dtype=bool)
@@ -325,13 +350,16 @@ def d_from_cubics(
     use_c = ~is_line & ~as_z
     mask = np.stack([first, use_c, use_c, ~as_z], axis=1)  # (k, 4) over p0, c1, c2, p3
     out = []
-    for lo in range(0, k, _WRITE_BLOCK):  # blocks: fixed-width string arrays of 10^6 segments take GiBs
-        part = slice(lo, lo + _WRITE_BLOCK)
+    for part in blocks:  # blocks: fixed-width string arrays of 10^6 segments take GiBs
+        xy = np.stack([cubics[part].real, cubics[part].imag], axis=-1)  # (b, 4, 2)
+        xy += 0.0  # turns -0.0 into 0.0
+        xy[np.abs(xy) < 1e-12 * scale] = 0.0
         pieces = np.where(is_line[part], f"L{pair} ", f"C{pair} {pair} {pair} ")
         pieces[as_z[part]] = ""
         text = np.char.add(
             np.char.add(np.where(first[part], f"M{pair} ", ""), pieces), np.where(seg_closed[part], "Z ", "")
         )
-        values = xy[part][mask[part]]  # row-major: segment by segment, points in order
+        values = xy[mask[part]]  # row-major: segment by segment, points in order
         out.append("".join(text.tolist()) % tuple(values.ravel().tolist()))
-    return "".join(out).rstrip()
+    out[-1] = out[-1].rstrip()  # every segment writes a command: only the last piece ends in blanks
+    return "".join(out)

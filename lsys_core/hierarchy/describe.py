@@ -236,13 +236,13 @@ def grammar_bits(g: Grammar, prec: Precision, *, shapes: bool = True) -> float:
     A body that only places symbols (``[T A] [T B] …``) is charged the cheaper of the token
     code and the set code.  With ``shapes``, the terminals' path data counts too.
     """
-    from lsys_core.geometry.paths import cubics_from_d
+    from lsys_core.geometry.shapes import shape_arrays
 
     token = token_bits(len(g.terminals) + len(g.rules))
     radius: dict[str, float] = {}
     bits = 0.0
     for t in g.terminals:
-        cubics, _, _ = cubics_from_d(t.path)
+        cubics, _, _ = shape_arrays(t.path)  # parsed once for all stages (10^6 segments: 61 MiB)
         if cubics.size:
             radius[t.name] = float(np.max(np.abs(cubics - cubics.mean())))
             if shapes:

@@ -64,11 +64,16 @@ def linear_candidates(
     cluster = lab[e1]
     e1, e2 = idx[e1], idx[e2]
     ang = np.deg2rad(tol.angle)
-    da = np.deg2rad(wrap_deg(ps.alpha[e2] - ps.alpha[e1]))
-    db = np.deg2rad(wrap_deg(ps.beta[e2] - ps.beta[e1]))
-    emb2 = np.column_stack(
-        [np.cos(da) / ang, np.sin(da) / ang, np.cos(db) / ang, np.sin(db) / ang, cluster * 1e7]
-    )
+    # The steps of α and β as (cos, sin) / ang, and the cluster: filled in place, column by
+    # column (stacking five temporaries doubled this array's 77 MiB at 20,000 elements).
+    emb2 = np.empty((e1.size, 5))
+    for col, angles in ((0, ps.alpha), (2, ps.beta)):
+        step = np.deg2rad(wrap_deg(angles[e2] - angles[e1]))
+        np.cos(step, out=emb2[:, col])
+        np.sin(step, out=emb2[:, col + 1])
+    del step
+    emb2[:, :4] /= ang
+    emb2[:, 4] = cluster * 1e7
     lab2, _ = mean_shift(emb2)
     if ledger is not None:
         lab2 = _promising(ledger, lab2, e1, e2, ps)
@@ -86,7 +91,7 @@ def linear_candidates(
         if abs(dA) < tol.angle and abs(dB) < tol.angle:
             continue  # constant transform: a cluster C already covers it
         problems.append((e1[g2], e2[g2], dA, dB))
-    del emb2, lab2, e1, e2, cluster, da, db  # millions of consecutive pairs at 50,000 elements
+    del emb2, lab2, e1, e2, cluster  # millions of consecutive pairs at 50,000 elements
     batches = _batches([p[0].size for p in problems], parallel.jobs())
     solved = parallel.pmap(lambda b: _linear_chains(ctx, sym, ps, problems[b[0] : b[1]], prox), batches)
     return [c for part in solved for c in part]

@@ -62,6 +62,8 @@ class Reference:
         rho = np.abs(points)
         order = np.argsort(rho, kind="stable")
         pts = (dense.points[0] - origin) * inv
+        local = np.asarray(cubics, dtype=complex).reshape(-1, 4) - origin
+        local *= inv
         return cls(
             points=points,
             normals=coarse.normals[0],
@@ -71,7 +73,7 @@ class Reference:
             dense_frac=dense_frac,
             dense_seg=dense.segment[0],
             dense_t=dense.param[0],
-            cubics=(np.asarray(cubics, dtype=complex).reshape(-1, 4) - origin) * inv,
+            cubics=local,
             dense_step=float(dense.length[0]) * inv / pts.size,
             open_path=open_path,
             tree=cKDTree(np.column_stack([pts.real, pts.imag])),

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lsys_core.geometry.paths import collinear_thirds
+from lsys_core.geometry.paths import collinear_thirds, consecutive
 from lsys_core.svg.model import Element
 
 __all__ = ["Samples", "arc_fractions", "bezier", "element_features", "sample_elements"]
@@ -60,7 +60,10 @@ def _stack(elements: list[Element] | tuple[Element, ...]) -> tuple[np.ndarray, n
     counts = np.array([e.cubics.shape[0] for e in elements], dtype=np.int64)
     if counts.sum() == 0:
         return np.zeros((0, 4), complex), np.zeros(0, np.int64)
-    cubics = np.concatenate([np.asarray(e.cubics, dtype=complex).reshape(-1, 4) for e in elements])
+    arrays = [np.asarray(e.cubics, dtype=complex).reshape(-1, 4) for e in elements]
+    cubics = consecutive(arrays)  # a scene's elements are pieces of one array: no copy
+    if cubics is None:
+        cubics = np.concatenate(arrays)
     owner = np.repeat(np.arange(len(elements)), counts)
     return cubics, owner
 
@@ -148,10 +151,12 @@ def sample_elements(
     if cubics.shape[0] == 0:
         return Samples(points, normals, curv, length, np.zeros((n, s), np.int64), np.zeros((n, s)))
     chords = _chord_table(cubics)  # (K * T,) arc length of every sub-interval
-    cum = np.concatenate([[0.0], np.cumsum(chords)])
-    chord_owner = np.repeat(owner, _TABLE)
-    first = np.searchsorted(chord_owner, np.arange(n), side="left")
-    last = np.searchsorted(chord_owner, np.arange(n), side="right") - 1
+    cum = np.empty(chords.size + 1)
+    cum[0] = 0.0
+    np.cumsum(chords, out=cum[1:])
+    # Every element's first and last sub-interval (its segments' eighths are consecutive).
+    first = np.searchsorted(owner, np.arange(n), side="left") * _TABLE
+    last = np.searchsorted(owner, np.arange(n), side="right") * _TABLE - 1
     present = last >= first
     start = np.where(present, cum[np.minimum(first, chords.size - 1)], 0.0)
     end = np.where(present, cum[np.minimum(last, chords.size - 1) + 1], 0.0)

@@ -32,6 +32,8 @@ __all__ = ["TOLERANCE", "primitive"]
 TOLERANCE = 1e-3
 #: Significant digits of the numbers written.
 DIGITS = 7
+#: Segments tested for straightness at once (the test's temporaries are about 200 bytes a segment).
+_BLOCK = 1 << 16
 
 
 def _num(v: float, unit: float = 0.0) -> str:
@@ -95,12 +97,14 @@ def primitive(d: str) -> tuple[str, dict[str, str]] | None:
     if size <= 0:
         return None
     tol = TOLERANCE * size
-    straight = _straight(cubics, tol)
     if not closed[0]:
-        if cubics.shape[0] == 1 and straight[0]:
+        if cubics.shape[0] == 1 and _straight(cubics, tol)[0]:
             (p, q) = cubics[0, 0], cubics[0, 3]
             return "line", {"x1": _num(p.real), "y1": _num(p.imag), "x2": _num(q.real), "y2": _num(q.imag)}
         return None
+    straight = np.concatenate(
+        [_straight(cubics[lo : lo + _BLOCK], tol) for lo in range(0, cubics.shape[0], _BLOCK)]
+    )
     if straight.all():
         return _rect(cubics, tol)
     if not straight.any():

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from lsys_core.errors import LimitError, SvgError
-from lsys_core.geometry.paths import MAX_COORD
+from lsys_core.geometry.paths import MAX_COORD, consecutive
 from lsys_core.grammar.model import Verbatim
 from lsys_core.quoting import quote_name
 from lsys_core.svg.model import Element, Scene
@@ -268,28 +268,18 @@ def _joined(recs: list[ShapeRecord], counts: np.ndarray) -> np.ndarray:
     are not read again once placed (a hidden record may share a drawn one's piece).  Otherwise
     the cubics are copied.
     """
-    base = recs[0].path.cubics.base
+    arrays = [r.path.cubics for r in recs]
+    joined = consecutive(arrays)
+    owner = None if joined is None else joined.base
     if (
-        isinstance(base, np.ndarray)
-        and base.dtype == complex
-        and base.ndim == 2
-        and base.shape == (int(counts.sum()), 4)
-        and base.flags.c_contiguous
-        and base.flags.writeable
-        and sys.getrefcount(base) == len(recs) + 2  # one view per record, ``base``, the argument
+        owner is not None
+        and owner.shape == (int(counts.sum()), 4)
+        and owner.dtype == complex
+        and owner.flags.writeable
+        and sys.getrefcount(owner) == len(recs) + 3  # a view per record, ``joined``, ``owner``, the argument
     ):
-        row = base.strides[0]
-        at = base.__array_interface__["data"][0]
-        tiles = True
-        for r, n in zip(recs, counts.tolist(), strict=True):
-            c = r.path.cubics
-            tiles = c.base is base and c.__array_interface__["data"][0] == at and c.flags.c_contiguous
-            if not tiles:
-                break
-            at += n * row
-        if tiles:
-            return base
-    return np.concatenate([r.path.cubics for r in recs])
+        return owner
+    return np.concatenate(arrays)
 
 
 def _skip_messages(skips: Counter) -> list[str]:

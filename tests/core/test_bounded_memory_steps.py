@@ -131,3 +131,43 @@ def test_cubics_placed_in_place_or_copied_are_the_same(monkeypatch):
     np.testing.assert_allclose(
         scenes[0].elements[0].cubics, (c * x - s * y) + 1j * (s * x + c * y), atol=1e-9
     )
+
+
+def test_elements_sampled_in_their_scene_array_or_copied_are_the_same():
+    from lsys_core.instancing.sampling import arc_fractions, sample_elements
+
+    body = "".join(
+        f'<path d="M{i} 0 C {i + 3} 5 {i + 6} -5 {i + 9} 0 L {i + 9} 9 Z"/><rect x="{i}" y="20" width="3" height="{i + 1}"/>'
+        for i in range(0, 60, 10)
+    )
+    scene = parse_svg(f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 99 99">{body}</svg>'.encode())
+    views = list(scene.elements)
+    assert paths.consecutive([e.cubics for e in views]) is not None  # one array: sampled in place
+    copies = [Element(e.cubics.copy(), e.subpaths, e.closed) for e in views]
+    assert paths.consecutive([e.cubics for e in copies]) is None
+    for els in (views, views[::2]):
+        a = sample_elements(els, arc_fractions(16))
+        b = sample_elements([copies[views.index(e)] for e in els], arc_fractions(16))
+        for got, want in zip(
+            (a.points, a.normals, a.curvature, a.length),
+            (b.points, b.normals, b.curvature, b.length),
+            strict=True,
+        ):
+            assert got.tobytes() == want.tobytes()
+
+
+def test_primitives_recognised_in_blocks_are_the_same(monkeypatch):
+    from lsys_core.render import primitives
+
+    shapes = [
+        "M0 0 H10 V5 H0 Z",
+        "M0 0 H5 H10 V5 H0 Z",  # a side split in two
+        "M 10 0 A 10 5 0 0 1 -10 0 A 10 5 0 0 1 10 0 Z",
+        "M 2 0 H 8 A 2 2 0 0 1 10 2 V 4 A 2 2 0 0 1 8 6 H 2 A 2 2 0 0 1 0 4 V 2 A 2 2 0 0 1 2 0 Z",
+        "M1 2 L4 6",
+        "M0 0 L 3 3 L 5 0",
+    ]
+    whole = [primitives.primitive(d) for d in shapes]
+    assert sum(w is not None for w in whole) >= 4
+    monkeypatch.setattr(primitives, "_BLOCK", 2)
+    assert [primitives.primitive(d) for d in shapes] == whole
