@@ -235,7 +235,7 @@ def build_hierarchy(
                 n_terminals=nt,
                 limit=limit,
             )
-            chosen = choose(cands, weights, len(nodes), test)
+            chosen = choose(cands, weights, len(nodes), test, ledger.ceiling)
         if chosen:
             level += 1
             nodes = _apply_all(table, book, chosen, nodes)

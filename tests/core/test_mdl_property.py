@@ -10,7 +10,7 @@ The examples are derandomised: the same cases run every time.
 
 from __future__ import annotations
 
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from lsys_core.derive import derive
@@ -95,7 +95,11 @@ def nested(draw) -> str:
             + f"axiom: P({n - 1})\nX -> A f(20) B\n"
             + _seq("P", f"[ f({r}) X ] +({round(360.0 / n, 6)})", f"f({r}) X")
         )
-    k = draw(st.integers(2, 4))
+    return _row_of_rings(n, r, draw(st.integers(2, 4)))
+
+
+def _row_of_rings(n: int, r: float, k: int) -> str:
+    """A row of ``k`` rings of ``n`` leaves, ``2.6 r`` apart."""
     return (
         HEAD
         + f"axiom: Q({k - 1})\n"
@@ -112,6 +116,9 @@ def nested(draw) -> str:
     suppress_health_check=[HealthCheck.too_slow],
 )
 @given(st.one_of(sequences(), rings(), grids(), branchings(), nested()))
+# three rings of four leaves close together: a branching of two pairs of leaves (0.1 bit saved)
+# was more important than the rings (111 bits) and left 239 bits where the truth has 120
+@example(_row_of_rings(4, 30.0, 3))
 def test_inferred_grammar_redraws_the_drawing_and_is_no_longer_than_the_truth(text: str) -> None:
     truth = parse_grammar(text)
     drawing = derive(truth)

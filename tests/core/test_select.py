@@ -78,3 +78,21 @@ def test_equal_importance_goes_by_bits_saved():
     other = _candidate([3, 4], 0.25, 2, gain=9.0)  # less important, disjoint
     got = choose([small, large, other], Weights(), 1000, lambda c: c)
     assert got == [large, other]
+
+
+def test_a_candidate_that_saves_far_fewer_bits_yields_to_one_on_its_nodes():
+    important = _candidate([0, 1], 1.0, 0, gain=0.5)  # close pairs: the most important, saves little
+    rings = _candidate([1, 2, 3, 4], 0.25, 1, gain=100.0)  # less important, on one of its nodes
+    modest = _candidate([4, 5], 0.25, 2, gain=20.0)
+
+    def ceiling(c: Candidate) -> float:
+        return c.gain
+
+    assert choose([important, rings], Weights(), 6, lambda c: c, ceiling) == [rings]
+    assert choose([important, rings], Weights(), 6, lambda c: c) == [important]  # importance alone
+    # saving 4 times as much and 32 bits more: a candidate worth 20 bits keeps its place
+    worth = _candidate([0, 4], 1.0, 0, gain=20.0)
+    assert choose([worth, modest], Weights(), 6, lambda c: c, ceiling)[0] is worth
+    # a candidate that saves 32 bits or more is not a weak one: importance decides
+    paying = _candidate([0, 1], 1.0, 0, gain=40.0)
+    assert choose([paying, rings], Weights(), 6, lambda c: c, ceiling) == [paying]
