@@ -52,12 +52,14 @@ class Tolerance:
     ``length`` is a floor of all three, as a share of the tolerance ``eps`` (a length in the
     drawing): transforms that move a node's outline by less than ``length·eps`` are not told
     apart, however small the shape (see :func:`~lsys_core.hierarchy.analysis.find_candidates`).
+    Off by default (0): at 0.5 it makes rings of hand-drawn dots of ±10 % sizes one rule, but a
+    chart of 4,817 arrows at many angles got a description 4 times longer (56,700 -> 243,300 bits).
     """
 
     xy: float = 0.02
     angle: float = 1.0
     scale: float = 0.01
-    length: float = 0.5
+    length: float = 0.0
 
     def scaled(self, factor: float) -> Tolerance:
         """Return the bandwidths multiplied by ``factor``."""
