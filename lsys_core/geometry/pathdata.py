@@ -97,8 +97,8 @@ def parse_paths(ds: list[str], max_numbers: int | None = None) -> PathTable:
     """
     n_paths = len(ds)
     messages: list[str | None] = [None] * n_paths
-    cmds = _commands(ds, max_numbers, messages)
-    return _execute(*cmds, n_paths, tuple(messages))
+    letters, first, arity, groups, let_path, values = _commands(ds, max_numbers, messages)
+    return _execute(letters, first, arity, groups, let_path, values, n_paths, tuple(messages))
 
 
 def _commands(ds: list[str], max_numbers: int | None, messages: list[str | None]) -> tuple:

@@ -216,9 +216,8 @@ def mean_shift(
     inv = np.searchsorted(cells, keys)
     del keys
     counts = np.bincount(inv, minlength=cells.size)
-    cent = np.column_stack(
-        [np.bincount(inv, weights=pts[:, k], minlength=cells.size) for k in range(pts.shape[1])]
-    )
+    sums = [np.bincount(inv, weights=pts[:, k], minlength=cells.size) for k in range(pts.shape[1])]
+    cent: np.ndarray = np.column_stack(sums).astype(float, copy=False)
     cent /= counts[:, None]
     w = counts.astype(float)
     tree = cKDTree(cent)
