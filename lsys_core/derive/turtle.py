@@ -161,6 +161,12 @@ def segmented_exclusive_cumsum(x: np.ndarray, starts: np.ndarray, lengths: np.nd
 
 def chain_frames(A: np.ndarray, B: np.ndarray, starts, lengths) -> tuple[np.ndarray, np.ndarray]:
     """Frames of a chain of steps relative to the chain start: ``F_{k+1} = F_k ∘ (A_k, B_k)``."""
+    if A.size and np.all(A[0] == A):  # one step transform for all (the usual case): its powers
+        with np.errstate(divide="ignore", invalid="ignore"):
+            log0 = np.log(A[0])
+        if np.isfinite(log0):
+            rel_a = _powers(log0, starts, lengths)
+            return rel_a, segmented_exclusive_cumsum(rel_a * B, starts, lengths)
     with np.errstate(divide="ignore", invalid="ignore"):
         logs = np.log(A)
     if np.all(np.isfinite(logs)):
@@ -176,3 +182,15 @@ def chain_frames(A: np.ndarray, B: np.ndarray, starts, lengths) -> tuple[np.ndar
             cur[owner[sel]] = cur[owner[sel]] * A[sel]
     rel_b = segmented_exclusive_cumsum(rel_a * B, starts, lengths)
     return rel_a, rel_b
+
+
+def _powers(log0: complex, starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """``A0**k`` for every step ``k`` of every chain, with ``log0 = log(A0)``.
+
+    The powers are computed once up to the longest chain and gathered: a complex ``exp`` of
+    every step took 40 % of deriving a 10,000-element grid.
+    """
+    longest = int(lengths.max(initial=0))
+    table = np.exp(np.arange(longest) * log0)
+    k = np.arange(int(lengths.sum())) - np.repeat(starts, lengths)
+    return table[k]

@@ -82,3 +82,22 @@ def test_randomize_is_seeded() -> None:
 def test_negative_counter_draws_nothing_and_eps() -> None:
     g = parse_grammar(HEADER + "axiom: P(-1) A\nP(m) -> A P(m-1)\n")
     assert len(derive(g)) == 1
+
+
+def test_chain_frames_of_one_step_equal_the_general_ones() -> None:
+    """Chains of one repeated step (its powers) give the frames of steps that differ (logs)."""
+    from lsys_core.derive.turtle import chain_frames
+
+    lengths = np.array([4, 0, 7, 1])
+    starts = np.concatenate(([0], np.cumsum(lengths)[:-1]))
+    step_a = 0.97 * np.exp(1j * np.deg2rad(11.0))
+    a = np.full(lengths.sum(), step_a)
+    b = np.linspace(1.0, 3.0, a.size) + 0.5j
+    fast_a, fast_b = chain_frames(a, b, starts, lengths)
+    nudged = a.copy()
+    nudged[-1] *= 1 + 1e-15  # one step differs (by nothing that shows): the general path
+    slow_a, slow_b = chain_frames(nudged, b, starts, lengths)
+    assert np.allclose(fast_a, slow_a, rtol=1e-12) and np.allclose(fast_b, slow_b, rtol=1e-12)
+    k = np.arange(a.size) - np.repeat(starts, lengths)
+    assert np.allclose(fast_a, step_a**k, rtol=1e-12)
+    assert fast_b[starts[0]] == 0 and np.isclose(fast_b[1], b[0])
