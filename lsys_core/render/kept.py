@@ -36,7 +36,7 @@ import math
 import urllib.parse
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Iterator
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from typing import Any
 
 import numpy as np
@@ -90,8 +90,16 @@ class Kept:
         self.served = served
         self.drawing, self.terminal, self.defs = drawing, terminal, drawing.defs
         self._styles: tuple[tuple[str, ...], np.ndarray] | None = None
-        _, _, w, h = default_view(drawing)
-        self.viewport = (float(w), float(h))  # what percentages refer to
+
+    @cached_property
+    def viewport(self) -> tuple[float, float]:
+        """The size percentages refer to: the drawing's viewBox or bounds.
+
+        Computed when first needed: the bounds of 10,000 instances took ~4 ms of every frame,
+        and most frames draw no kept item.
+        """
+        _, _, w, h = default_view(self.drawing)
+        return (float(w), float(h))
 
     def __bool__(self) -> bool:
         return bool(self.refs)

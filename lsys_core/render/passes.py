@@ -27,6 +27,8 @@ from lsys_core.render.paths import (
 
 #: Colour of highlighted instances (RGBA).
 HIGHLIGHT = (255, 111, 0, 255)
+#: Translucent fill of highlighted instances (RGBA): the highlight at half opacity.
+HIGHLIGHT_FILL = (255, 111, 0, 127)
 #: In draft mode, strokes thinner than this many pixels are drawn as hairlines.
 DRAFT_HAIRLINE = 2.0
 #: In draft mode, curves are replaced by lines at most this many pixels away from them.
@@ -237,42 +239,72 @@ def _draft_batches(terms, symbol, da, db, sscale, idx):
             yield term, stroke_px, batch_path(points, verbs, da[part], db[part], term.paints.evenodd)
 
 
-def draw_draft(canvas, terms, symbol, da, db, sscale, visible) -> None:
-    """Draft: per terminal and scale bucket, chunks of instances drawn as one path each."""
-    idx = np.flatnonzero(visible)
-    if idx.size == 0:
-        return
+def draw_draft(canvas, terms, symbol, da, db, sscale, visible, highlight=None) -> None:
+    """Draft: per terminal and scale bucket, chunks of instances drawn as one path each.
+
+    Instances in the ``highlight`` mask (None: none) are drawn after the others, each in one
+    pass that looks like the draft plus :func:`draw_highlight` on top: their fill already
+    blended with the translucent highlight, the highlight's hairline outline instead of a
+    hairline stroke (it covers the same pixels).  Measured on 10,000 highlighted leaves, the
+    separate highlight pass made a draft frame take 16–28 ms instead of 10–12 ms.
+    """
+    plain = visible if highlight is None else visible & ~highlight
+    idx = np.flatnonzero(plain)
     for term, stroke_px, path in _draft_batches(terms, symbol, da, db, sscale, idx):
         paints = term.paints
         if term.fill_noaa is not None:
             canvas.drawPath(path, term.fill_noaa)
         if paints.stroke is not None:
-            width = paints.width * stroke_px
-            if width < DRAFT_HAIRLINE:
-                width = 0.0  # a hairline: far cheaper than stroking thin outlines
+            width = _draft_width(paints, stroke_px)
             canvas.drawPath(path, _skia_paint(paints.stroke, False, paints, width))
-
-
-def draw_highlight(canvas, terms, symbol, da, db, mask, antialias: bool, draft: bool = False) -> None:
-    """Draw the selected instances on top in the :data:`HIGHLIGHT` colour.
-
-    Filled terminals get a translucent fill, every one a 1.5-pixel outline.  In ``draft`` mode
-    the outlines are the draft's (flattened, batched per terminal and scale) and the outline is a
-    hairline: measured on 10,000 highlighted leaves, a draft frame took 77–82 ms with the full
-    outlines and takes 25 ms now (the draft alone: 16–19 ms).
-    """
-    r, g, b, a = HIGHLIGHT
-    aa = antialias and not draft
-    width = 0.0 if draft else 1.5
-    fill = _skia_paint((r, g, b, a // 2), aa)
-    outline = _skia_paint((r, g, b, a), aa, _Paints(None, None, width, "round", "round", 4.0, False), width)
-    if draft:
-        idx = np.flatnonzero(mask & (symbol < len(terms)))
-        for term, _, path in _draft_batches(terms, symbol, da, db, np.ones(symbol.size), idx):
-            if term.paints.fill is not None:
-                canvas.drawPath(path, fill)
-            canvas.drawPath(path, outline)
+    if highlight is None:
         return
+    idx = np.flatnonzero(visible & highlight & (symbol < len(terms)))
+    outline = _highlight_paints(False, True)[1]
+    for term, stroke_px, path in _draft_batches(terms, symbol, da, db, sscale, idx):
+        paints = term.paints
+        if paints.fill is not None:
+            canvas.drawPath(path, _skia_paint(over(HIGHLIGHT_FILL, paints.fill), False))
+        if paints.stroke is not None:
+            width = _draft_width(paints, stroke_px)
+            if width > 0.0:  # a hairline stroke is what the outline covers anyway
+                canvas.drawPath(path, _skia_paint(paints.stroke, False, paints, width))
+        canvas.drawPath(path, outline)
+
+
+def _draft_width(paints: _Paints, stroke_px: float) -> float:
+    """The draft's stroke width in pixels: 0 (a hairline, far cheaper) under :data:`DRAFT_HAIRLINE`."""
+    width = paints.width * stroke_px
+    return 0.0 if width < DRAFT_HAIRLINE else width
+
+
+def over(top: tuple[int, int, int, int], under: tuple[int, int, int, int]) -> tuple[int, int, int, int]:
+    """Return the one straight RGBA colour that paints like ``under`` then ``top`` (source over)."""
+    ta, ua = top[3] / 255.0, under[3] / 255.0
+    alpha = ta + ua * (1.0 - ta)
+    if alpha <= 0.0:
+        return (0, 0, 0, 0)
+    rgb = ((t * ta + u * ua * (1.0 - ta)) / alpha for t, u in zip(top[:3], under[:3], strict=True))
+    r, g, b = (min(255, max(0, round(c))) for c in rgb)
+    return (r, g, b, min(255, round(alpha * 255.0)))
+
+
+def _highlight_paints(antialias: bool, draft: bool):
+    """The highlight's translucent fill and its outline (a hairline in drafts, else 1.5 pixels)."""
+    r, g, b, a = HIGHLIGHT
+    width = 0.0 if draft else 1.5
+    fill = _skia_paint(HIGHLIGHT_FILL, antialias)
+    stroke = _Paints(None, None, width, "round", "round", 4.0, False)
+    return fill, _skia_paint((r, g, b, a), antialias, stroke, width)
+
+
+def draw_highlight(canvas, terms, symbol, da, db, mask, antialias: bool) -> None:
+    """Draw the selected instances on top in the :data:`HIGHLIGHT` colour (full mode).
+
+    Filled terminals get a translucent fill, every one a 1.5-pixel outline (drafts draw their
+    highlighted instances in :func:`draw_draft`).
+    """
+    fill, outline = _highlight_paints(antialias, False)
     for t, term in enumerate(terms):
         sel = np.flatnonzero(mask & (symbol == t))
         if sel.size == 0:

@@ -21,7 +21,10 @@ few big paths (:data:`DRAFT_CHUNK` instances each, built once and used for both
 the fill and the stroke), without anti-aliasing, with curves flattened into lines
 within :data:`DRAFT_TOLERANCE` pixels and with thin strokes as hairlines: much
 faster, but overlaps between different terminals or scale groups no longer follow
-the instance order (within a group, chunks are drawn in instance order).
+the instance order (within a group, chunks are drawn in instance order).  Small opaque
+instances are not drawn as paths but stamped as sprites, over the paths (:mod:`.sprites`:
+10,000 leaves of ~6 pixels in 2–3 ms instead of 7–9 ms), and highlighted instances are drawn
+last, highlighted in the same pass.
 
 Content kept as is (text, images) and instances painted by gradients are drawn at their
 places in the paint order in full mode (:mod:`lsys_core.render.kept`, :mod:`.served`); in
@@ -43,6 +46,7 @@ from lsys_core.io import write_atomic
 from lsys_core.render.kept import Kept
 from lsys_core.render.passes import (
     DRAFT_CHUNK,
+    DRAFT_HAIRLINE,
     DRAFT_TOLERANCE,
     FULL_MIN_RUN,
     FULL_ROWS_PER_INSTANCE,
@@ -63,6 +67,7 @@ from lsys_core.render.paths import (
 )
 from lsys_core.render.sizing import default_view, fit_view, png_size
 from lsys_core.render.skia_import import load_skia
+from lsys_core.render.sprites import Sprites
 from lsys_core.render.units import CSS_DPI
 
 __all__ = [
@@ -105,6 +110,7 @@ class Renderer:
 
     def __init__(self, width: int, height: int) -> None:
         self._cache: dict[tuple[str, str], _Terminal] = {}
+        self._sprites = Sprites()
         self.resize(width, height)  # sets the pixels, the skia surface and its canvas
 
     @property
@@ -207,21 +213,22 @@ class Renderer:
             db = s * pb + complex(tx, ty)
         visible = self._visible(terms, symbol, da, db, sscale, width, height)
         visible[kept.served] = False  # gradient-painted: drawn by kept, at their places
+        mask = None if highlight is None else _mask(highlight, n)
         if draft:  # kept content placed before every instance goes under them, the rest on top
             kept.draw(canvas, np.flatnonzero(kept.orders == 0).tolist(), (s, tx, ty))
-            self._draw_batched(terms, symbol, da, db, sscale, visible)
+            stamp = self._sprites.plan(
+                terms, symbol, da, db, sscale, np.flatnonzero(visible), mask, DRAFT_HAIRLINE
+            )
+            self._draw_batched(
+                terms, symbol, da, db, sscale, visible & ~stamp.mask if stamp else visible, mask
+            )
+            if stamp is not None:  # small instances, over the paths
+                stamp.apply(self._pixels)
             kept.draw(canvas, np.flatnonzero(kept.orders > 0).tolist(), (s, tx, ty))
         else:
             self._draw_each(terms, symbol, da, db, sscale, visible, antialias, kept, (s, tx, ty))
-        if highlight is not None:
-            mask = np.zeros(n, dtype=bool)
-            hl = np.asarray(highlight).reshape(-1)
-            if hl.dtype == bool:
-                mask[: min(n, hl.size)] = hl[:n]
-            else:
-                hl = hl.astype(np.intp)
-                mask[hl[(hl >= 0) & (hl < n)]] = True
-            self._draw_highlight(terms, symbol, da, db, visible & mask, antialias, draft)
+            if mask is not None:
+                self._draw_highlight(terms, symbol, da, db, visible & mask, antialias)
         canvas.resetMatrix()
         return self._pixels
 
@@ -280,17 +287,30 @@ class Renderer:
             else:
                 kept.draw(self._canvas, items, view)
 
-    def _draw_batched(self, terms, symbol, da, db, sscale, visible) -> None:
-        """Draft: per terminal and scale bucket, chunks of instances drawn as one path each."""
+    def _draw_batched(self, terms, symbol, da, db, sscale, visible, highlight=None) -> None:
+        """Draft: per terminal and scale bucket, chunks of instances drawn as one path each
+        (the ``highlight`` mask's instances last, highlighted)."""
         self._canvas.resetMatrix()
-        draw_draft(self._canvas, terms, symbol, da, db, sscale, visible)
+        draw_draft(self._canvas, terms, symbol, da, db, sscale, visible, highlight)
 
     _batch_path = staticmethod(batch_path)
 
-    def _draw_highlight(self, terms, symbol, da, db, mask, antialias: bool, draft: bool) -> None:
-        """Draw the selected instances on top in the highlight colour."""
+    def _draw_highlight(self, terms, symbol, da, db, mask, antialias: bool) -> None:
+        """Draw the selected instances on top in the highlight colour (full mode)."""
         self._canvas.resetMatrix()
-        draw_highlight(self._canvas, terms, symbol, da, db, mask, antialias, draft)
+        draw_highlight(self._canvas, terms, symbol, da, db, mask, antialias)
+
+
+def _mask(highlight: np.ndarray, n: int) -> np.ndarray:
+    """Return the boolean mask of ``n`` instances that ``highlight`` (indices or mask) selects."""
+    mask = np.zeros(n, dtype=bool)
+    hl = np.asarray(highlight).reshape(-1)
+    if hl.dtype == bool:
+        mask[: min(n, hl.size)] = hl[:n]
+    else:
+        hl = hl.astype(np.intp)
+        mask[hl[(hl >= 0) & (hl < n)]] = True
+    return mask
 
 
 def _unpremultiply(pixels: np.ndarray) -> np.ndarray:

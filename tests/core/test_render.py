@@ -160,3 +160,25 @@ def test_render_png(tmp_path):
     with pytest.raises(LsysError, match="cannot write"):
         render_png(dr, tmp_path / "missing" / "x.png", 10, 10)
     assert [p.name for p in tmp_path.iterdir()] == ["out.png"]
+
+
+def test_draft_highlight_blends_in_one_pass() -> None:
+    """A highlighted draft instance shows its fill under the translucent highlight and the outline;
+    a stroke wider than a hairline stays under the outline."""
+    from lsys_core.render.passes import HIGHLIGHT_FILL, over
+
+    sq = Terminal("S", SQUARE, "fill:#0000ff")
+    dr = drawing_of([sq], [0, 0], [2, 2], [10 + 10j, 60 + 10j])
+    full = render(dr, 100, 100, highlight=np.array([1]), antialias=False)
+    draft = render(dr, 100, 100, highlight=np.array([1]), draft=True)
+    assert tuple(draft[20, 20]) == (0, 0, 255, 255)  # not highlighted
+    blend = over(HIGHLIGHT_FILL, (0, 0, 255, 255))
+    assert np.abs(draft[20, 70].astype(int) - blend).max() <= 1
+    assert np.abs(full[20, 70].astype(int) - draft[20, 70].astype(int)).max() <= 2
+    assert tuple(draft[10, 70, :3]) == HIGHLIGHT[:3]  # the outline on the square's top edge
+    thick = Terminal("S", SQUARE, "fill:#0000ff;stroke:#00ff00;stroke-width:4")
+    dr = drawing_of([thick], [0], [2], [50 + 50j])
+    draft = render(dr, 100, 100, highlight=np.array([0]), draft=True)
+    assert tuple(draft[48, 60, :3]) == (0, 255, 0)  # inside the stroke (y 48..52), off the outline
+    assert over((9, 9, 9, 255), (200, 0, 0, 255)) == (9, 9, 9, 255)
+    assert over((9, 9, 9, 0), (200, 0, 0, 128)) == (200, 0, 0, 128)
