@@ -30,6 +30,7 @@ from .document import Document
 from .handles import HandleEditor, HandleOverlay
 from .inference_panel import InferencePanel
 from .message_bar import MessageBar
+from .pacing import GesturePacing
 from .params_panel import ParamsPanel
 from .recent_files import RecentFiles
 from .recovery import Recovery
@@ -157,7 +158,8 @@ class MainWindow(WindowFiles, WindowEdits, QMainWindow):
 
     def _connect(self) -> None:
         d = self.doc
-        d.textChanged.connect(self.rules_panel.set_text)
+        self.pacing = GesturePacing(d, self.rules_panel.set_text, self._panels_timer.start, self)
+        d.textChanged.connect(self.pacing.text_changed)
         d.grammarError.connect(self.rules_panel.set_error)
         d.grammarError.connect(self._on_grammar_error)
         d.grammarChanged.connect(self._on_grammar_changed)
@@ -237,7 +239,7 @@ class MainWindow(WindowFiles, WindowEdits, QMainWindow):
         self._update_actions()
 
     def _on_grammar_changed(self, grammar: Any) -> None:
-        self._panels_timer.start()  # the panels follow in their own event-loop turn
+        self.pacing.grammar_changed()  # the panels follow in their own event-loop turn (paced in gestures)
         self._update_status()
         self._update_actions()
 
@@ -379,6 +381,7 @@ class MainWindow(WindowFiles, WindowEdits, QMainWindow):
             not self.doc.busy
             and self.canvas.is_idle()
             and not self._panels_timer.isActive()
+            and not self.pacing.pending
             and not self.rules_panel.editor.highlighter.pending
         )
 

@@ -108,3 +108,46 @@ def test_plus_and_minus_change_the_count_by_one(helix, qtbot, wait_idle):
     )
     wait_idle(helix)
     assert len(doc.drawing) == n and doc.undo_stack.count() == 2
+
+
+def test_a_drag_shows_drafts_of_the_new_step_and_the_text_follows_paced(helix, qtbot, wait_idle):
+    """While the pointer moves, the canvas shows draft frames of the moved instances at their new
+    places; the rules text and panels follow at most every GESTURE_FOLLOW_MS and at once on the
+    release, which renders at full quality; the whole drag is one undo step."""
+    from app.pacing import GESTURE_FOLLOW_MS
+
+    doc, canvas = helix.doc, helix.canvas
+    before = doc.text
+    h = helix.handles.handles
+    start = _widget_point(helix, h.b1)
+    QTest.mousePress(canvas, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, start)
+    helix.pacing._timer.setInterval(60_000)  # no paced update during this test: only the release's
+    for dx in (6, 12, 18):
+        p = start + QPoint(dx, 0)
+        event = QMouseEvent(
+            QEvent.Type.MouseMove,
+            QPointF(p),
+            QPointF(canvas.mapToGlobal(p)),
+            Qt.MouseButton.NoButton,
+            Qt.MouseButton.LeftButton,
+            Qt.KeyboardModifier.NoModifier,
+        )
+        QApplication.sendEvent(canvas, event)
+        qtbot.waitUntil(
+            lambda: not doc.busy and canvas._frame is not None and canvas._frame.drawing is doc.drawing,
+            timeout=10_000,
+        )
+        frame = canvas._frame
+        assert frame.draft  # drag speed
+        x, y = canvas.view.to_doc(p.x(), p.y())
+        pixel = 1.0 / canvas.view.zoom
+        d = frame.drawing  # the step from 5 to 6 (in 5's frame) goes where the pointer is
+        assert abs((d.b[6] - d.b[5]) - (complex(x, y) - h.b0) * d.a[5] / h.a0) <= pixel
+        assert doc.text != before and helix.rules_panel.text() == before  # the text waits (paced)
+        assert helix.pacing.pending and not helix.is_idle()
+    QTest.mouseRelease(canvas, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, p)
+    wait_idle(helix)
+    assert not canvas._frame.draft and canvas._frame.drawing is doc.drawing  # full quality on release
+    assert helix.rules_panel.text() == doc.text != before and not helix.pacing.pending
+    assert doc.undo_stack.count() == 1
+    assert GESTURE_FOLLOW_MS > 0
