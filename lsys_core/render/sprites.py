@@ -35,8 +35,11 @@ __all__ = ["SCALES_PER_OCTAVE", "SPRITE_MAX_PX", "Sprites", "Stamp"]
 SPRITE_MAX_PX = 24.0
 #: Scale steps of the sprites per octave.
 SCALES_PER_OCTAVE = 16
-#: Most sprites drawn for one frame (the rest of its instances are drawn as paths) ...
-NEW_PER_FRAME = 256
+#: A sprite is drawn for a frame only when at least this many of its instances use it (drawing
+#: one takes about as long as drawing 10-20 instances as paths; it is kept for the next frames) ...
+MIN_USES = 8
+#: ... and at most this many are drawn for one frame (the rest of its instances are drawn as paths) ...
+NEW_PER_FRAME = 64
 #: ... and most kept by one :class:`Sprites` (all are dropped when it is full).
 CACHE_SIZE = 8192
 
@@ -137,6 +140,7 @@ class Sprites:
         parts: list[tuple[np.ndarray, ...]] = []
         made = 0
         usable = np.ones(keys.size, bool)
+        uses = np.bincount(which, minlength=keys.size)
         first = np.zeros(keys.size, np.intp)
         first[which[::-1]] = np.arange(which.size)[::-1]  # an instance of every key
         for u, i in enumerate(first.tolist()):
@@ -144,7 +148,7 @@ class Sprites:
             q, k, n, h = int(step[i]), int(angle[i]), int(turns[i]), bool(lit[i])
             entry = self._sprites.get((id(term), q, k, n, h))
             if entry is None or entry[0] is not term:  # (an id is only unique while its object lives)
-                if made >= NEW_PER_FRAME:
+                if made >= NEW_PER_FRAME or uses[u] < MIN_USES:
                     usable[u] = False
                     parts.append(_NONE)
                     continue

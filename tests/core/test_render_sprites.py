@@ -14,9 +14,9 @@ LEAF = "M 0 0 Q 5 -8 14 -2 Q 9 2 0 0 Z"
 
 
 def _leaves(style: str, scale: float = 0.5, n: int = 12):
-    """``n`` × ``n`` leaves on a 20-unit grid, each turned 7° more than the one before."""
+    """``n`` × ``n`` leaves on a 20-unit grid, each turned 30° more than the one before."""
     k = np.arange(n * n)
-    a = scale * np.exp(1j * np.deg2rad(7.0 * k))
+    a = scale * np.exp(1j * np.deg2rad(30.0 * k))
     b = 10 + 20 * (k % n) + 1j * (10 + 20 * (k // n))
     return make_drawing([Terminal("A", LEAF, style)], np.zeros(k.size), a, b, (0.0, 0.0, 20.0 * n, 20.0 * n))
 
@@ -91,3 +91,22 @@ def test_sprites_follow_the_terminals_of_each_drawing():
         assert ink.size and {tuple(c) for c in ink.tolist()} == {
             (int(colour[1:3], 16), 0, int(colour[5:], 16))
         }
+
+
+def test_a_sprite_is_drawn_only_for_enough_instances():
+    """Instances all at different angles (a sprite each) are drawn as paths: a sprite costs as
+    much to draw as several instances."""
+    k = np.arange(100)
+    drawing = make_drawing(
+        [Terminal("A", LEAF, "fill:#66bb6a")],
+        np.zeros(k.size),
+        0.5 * np.exp(1j * np.deg2rad(3.3 * k)),
+        10 + 20 * (k % 10) + 1j * (10 + 20 * (k // 10)),
+        (0.0, 0.0, 200.0, 200.0),
+    )
+    r = Renderer(200, 200)
+    calls: list = []
+    plan = r._sprites.plan
+    r._sprites.plan = lambda *args: calls.append(plan(*args)) or calls[-1]
+    r.draw(drawing, None, False, True)
+    assert calls == [None]
