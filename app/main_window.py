@@ -158,7 +158,8 @@ class MainWindow(WindowFiles, WindowEdits, QMainWindow):
 
     def _connect(self) -> None:
         d = self.doc
-        self.pacing = GesturePacing(d, self.rules_panel.set_text, self._panels_timer.start, self)
+        editor = self.rules_panel.editor
+        self.pacing = GesturePacing(d, self.rules_panel.set_text, self._panels_timer.start, self, editor)
         d.textChanged.connect(self.pacing.text_changed)
         d.grammarError.connect(self.rules_panel.set_error)
         d.grammarError.connect(self._on_grammar_error)

@@ -1,12 +1,20 @@
-"""Pacing the rules text and the panels while a gesture (a slider or handle drag) runs.
+"""When the rules text and the panels follow new rules: in their own event-loop turns, paced in gestures.
 
-Every pointer move of a drag makes new rules.  The canvas shows each of them as a draft frame
-(derived and rendered on workers); the rules text and the panels follow the same rules on
-the UI thread, which shares the GIL and the cores with those workers.  During a gesture they
-therefore follow at most every :data:`GESTURE_FOLLOW_MS` (the newest rules then), and at once
-when the gesture ends; outside gestures at once, as before.  Measured on a drag of a
-10,000-element grid's handle: the text and panel updates of every move ran while the move's
-derivation did and made it finish 3–8 ms later.
+New rules reach the canvas through workers (derived and rendered off the UI thread); the rules
+text and the panels follow the same rules on the UI thread, which shares the GIL and the cores
+with those workers.  So they never run in the turn that applies the rules: the text follows in
+the next turn and the panels in the turns after it (see ``MainWindow._update_panels``).
+Applying rules with 833 parameters, the text update in the same turn made that turn the
+longest UI stall (6–10 ms of CPU, 10–50 ms of wall time while the derivation ran).
+
+During a gesture (a slider or handle drag) every pointer move makes new rules: the text and
+panels then follow at most every :data:`GESTURE_FOLLOW_MS` (the newest rules then), and at once
+when the gesture ends.  Measured on a drag of a 10,000-element grid's handle: the text and
+panel updates of every move ran while the move's derivation did and made it finish 3–8 ms
+later.
+
+The text shown is always the document's newest, and any input to the text editor (a key, a
+click, a drop) first shows the text that waits: an edit never starts from older text.
 """
 
 from __future__ import annotations
@@ -14,7 +22,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from PySide6.QtCore import QObject, QTimer
+from PySide6.QtCore import QEvent, QObject, QTimer
 
 __all__ = ["GESTURE_FOLLOW_MS", "GesturePacing"]
 
@@ -22,17 +30,32 @@ __all__ = ["GESTURE_FOLLOW_MS", "GesturePacing"]
 GESTURE_FOLLOW_MS = 100
 
 
+_INPUT = frozenset(
+    {
+        QEvent.Type.KeyPress,
+        QEvent.Type.ShortcutOverride,
+        QEvent.Type.InputMethod,
+        QEvent.Type.MouseButtonPress,
+        QEvent.Type.MouseButtonDblClick,
+        QEvent.Type.Drop,
+    }
+)
+
+
 class GesturePacing(QObject):
-    """Show new rules text and panels at once, or paced during a gesture.
+    """Show new rules text and panels in the next event-loop turns, paced during a gesture.
 
     Parameters
     ----------
     doc : Document
-        Its ``interactive`` says whether a gesture runs; its ``gestureFinished`` flushes.
+        Its ``text`` is shown, its ``interactive`` says whether a gesture runs, and its
+        ``gestureFinished`` shows what waits at once.
     show_text : callable
         ``show_text(text)`` shows the rules text.
     show_panels : callable
         ``show_panels()`` starts updating the panels for the document's grammar.
+    editor : QWidget, optional
+        The widget that shows the text: input to it first shows the text that waits.
     """
 
     def __init__(
@@ -41,50 +64,56 @@ class GesturePacing(QObject):
         show_text: Callable[[str], None],
         show_panels: Callable[[], None],
         parent: QObject | None = None,
+        editor: Any = None,
     ) -> None:
         super().__init__(parent)
+        if editor is not None:  # keys reach a text edit, mouse and drops its viewport
+            for widget in (editor, getattr(editor, "viewport", lambda: None)()):
+                if widget is not None:
+                    widget.installEventFilter(self)
         self._doc, self._show_text, self._show_panels = doc, show_text, show_panels
-        self._text: str | None = None
+        self._text = False
         self._panels = False
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
-        self._timer.setInterval(GESTURE_FOLLOW_MS)
         self._timer.timeout.connect(self.flush)
         doc.gestureFinished.connect(self.flush)
 
     @property
     def pending(self) -> bool:
         """Whether text or panels wait to show newer rules."""
-        return self._text is not None or self._panels
+        return self._text or self._panels
 
-    def text_changed(self, text: str) -> None:
-        """New rules text: shown now, or with the next paced update during a gesture."""
-        if self._doc.interactive:
-            self._text = text
-            self._arm()
-        else:
-            self._text = None
-            self._show_text(text)
+    def text_changed(self, _text: str = "") -> None:
+        """New rules text: shown in the next turn (paced during a gesture)."""
+        self._text = True
+        self._arm()
 
     def grammar_changed(self) -> None:
-        """New rules: the panels follow now, or with the next paced update during a gesture."""
-        if self._doc.interactive:
-            self._panels = True
-            self._arm()
-        else:
-            self._panels = False
-            self._show_panels()
+        """New rules: the panels follow after the text (paced during a gesture)."""
+        self._panels = True
+        self._arm()
 
     def flush(self) -> None:
-        """Show what waits now."""
+        """Show what waits now (the panels then update in turns of their own)."""
         self._timer.stop()
-        text, self._text = self._text, None
+        text, self._text = self._text, False
         panels, self._panels = self._panels, False
-        if text is not None:
-            self._show_text(text)
+        if text:
+            self._show_text(self._doc.text)
         if panels:
             self._show_panels()
 
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        """Show the waiting text before the editor handles input."""
+        if self._text and event.type() in _INPUT:
+            self._text = False
+            self._show_text(self._doc.text)
+        return False
+
     def _arm(self) -> None:
-        if not self._timer.isActive():  # a throttle, not a debounce: a long drag still updates
-            self._timer.start()
+        if self._doc.interactive:
+            if not self._timer.isActive():  # a throttle, not a debounce: a long drag still updates
+                self._timer.start(GESTURE_FOLLOW_MS)
+        elif not self._timer.isActive() or self._timer.interval() != 0:
+            self._timer.start(0)

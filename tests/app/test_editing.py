@@ -64,6 +64,7 @@ def test_editing_rule_text_rederives_and_keeps_last_drawing_while_invalid(
     _replace_in_editor(window, "f(24", "f(30)")
     qtbot.waitUntil(lambda: doc.error is None and doc.drawing is not good, timeout=120_000)
     assert not window.rules_panel.error_label.isVisible()
+    wait_idle(window)  # the panels follow the drawing in later event-loop turns
     assert window.params_panel.rows["P.0.1.v"].value() == pytest.approx(30)
 
 
@@ -147,7 +148,8 @@ def test_typing_merges_into_one_undo_step(window, helix_lsys, qtbot, wait_idle):
     assert window.doc.text.endswith("# a note")
     assert window.doc.undo_stack.count() == 1
     qtbot.keySequence(editor, QKeySequence(QKeySequence.StandardKey.Undo))
-    assert window.doc.text == window.rules_panel.text() and "# a note" not in window.doc.text
+    assert "# a note" not in window.doc.text
+    qtbot.waitUntil(lambda: window.rules_panel.text() == window.doc.text)  # in the next event-loop turn
 
 
 def test_randomize_is_seeded(window, helix_lsys, wait_idle):
