@@ -2,10 +2,12 @@
 
 New rules reach the canvas through workers (derived and rendered off the UI thread); the rules
 text and the panels follow the same rules on the UI thread, which shares the GIL and the cores
-with those workers.  So they never run in the turn that applies the rules: the text follows in
-the next turn and the panels in the turns after it (see ``MainWindow._update_panels``).
-Applying rules with 833 parameters, the text update in the same turn made that turn the
-longest UI stall (6–10 ms of CPU, 10–50 ms of wall time while the derivation ran).
+with those workers.  So they never run in the turn that applies the rules, and they wait for
+the derivation of the new rules (at most :data:`FOLLOW_WAIT_MS`): then the text follows in one
+turn and the panels in the turns after it (see ``MainWindow._update_panels``).  Applying rules
+with 833 parameters (their derivation holds the GIL for 50–100 ms of Python), the text
+update in the applying turn made that turn the longest UI stall (6–10 ms of CPU, 10–50 ms of
+wall time), and every panel step waited for the GIL several times.
 
 During a gesture (a slider or handle drag) every pointer move makes new rules: the text and
 panels then follow at most every :data:`GESTURE_FOLLOW_MS` (the newest rules then), and at once
@@ -19,15 +21,19 @@ click, a drop) first shows the text that waits: an edit never starts from older 
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from typing import Any
 
 from PySide6.QtCore import QEvent, QObject, QTimer
 
-__all__ = ["GESTURE_FOLLOW_MS", "GesturePacing"]
+__all__ = ["FOLLOW_WAIT_MS", "GESTURE_FOLLOW_MS", "GesturePacing"]
 
 #: During a gesture, the text and panels show the newest rules at most this often (ms).
 GESTURE_FOLLOW_MS = 100
+#: Outside gestures, the text and panels wait for the derivation of the new rules, at most this
+#: long (ms): they then run without sharing the GIL with it.
+FOLLOW_WAIT_MS = 150
 
 
 _INPUT = frozenset(
@@ -76,7 +82,10 @@ class GesturePacing(QObject):
         self._panels = False
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
-        self._timer.timeout.connect(self.flush)
+        self._timer.timeout.connect(self._due)
+        self._deadline = 0.0
+        self._deriver = doc.rules.deriver
+        self._deriver.busyChanged.connect(self._derived)
         doc.gestureFinished.connect(self.flush)
 
     @property
@@ -115,5 +124,19 @@ class GesturePacing(QObject):
         if self._doc.interactive:
             if not self._timer.isActive():  # a throttle, not a debounce: a long drag still updates
                 self._timer.start(GESTURE_FOLLOW_MS)
-        elif not self._timer.isActive() or self._timer.interval() != 0:
-            self._timer.start(0)
+            return
+        if not self._timer.isActive():
+            self._deadline = time.monotonic() + FOLLOW_WAIT_MS / 1000
+        self._timer.start(0)
+
+    def _due(self) -> None:
+        """The timer fired: show what waits, unless (outside a gesture) the derivation still runs."""
+        left = self._deadline - time.monotonic()
+        if not self._doc.interactive and self._deriver.busy and left > 0:
+            self._timer.start(max(1, round(left * 1000)))  # or sooner: when the derivation ends
+            return
+        self.flush()
+
+    def _derived(self) -> None:
+        if self.pending and not self._deriver.busy and not self._doc.interactive:
+            self.flush()

@@ -45,3 +45,19 @@ def test_a_key_pressed_before_the_text_follows_edits_the_new_text(open_rules, wa
     wait_idle(window)
     assert "f(13)" in doc.text and doc.text.rstrip().endswith("#x")  # the typing kept the new rules
     assert doc.undo_stack.count() == 2
+
+
+def test_the_text_waits_for_the_derivation_of_the_new_rules(open_rules, wait_idle, monkeypatch):
+    """Outside gestures the text and panels follow once the new rules are derived (they then do
+    not share the GIL with the derivation)."""
+    import app.pacing
+
+    monkeypatch.setattr(app.pacing, "FOLLOW_WAIT_MS", 600_000)  # only the derivation's end counts
+    window = open_rules(RULES)
+    doc = window.doc
+    seen = []
+    show = window.pacing._show_text
+    window.pacing._show_text = lambda text: (seen.append(doc.rules.deriver.busy), show(text))
+    doc.apply_grammar(core.set_params(doc.grammar, {"P.0.1.v": 13.0}), "test")
+    wait_idle(window)
+    assert seen == [False] and window.rules_panel.text() == doc.text
