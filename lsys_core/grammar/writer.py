@@ -81,20 +81,24 @@ def format_version(g: Grammar) -> int:
     ``[v0, v1, ...]``; a grammar without them is written in version 2 or 1.  Version 4 added
     the stretch command ``~(t)``.
     """
-    bodies = [g.axiom] + [c.body for r in g.rules for c in r.cases]
-    if any(isinstance(m, Turtle) and m.op == "~" for body in bodies for m in body):
+    stretch = table = modules_v2 = False
+    for body in [g.axiom] + [c.body for r in g.rules for c in r.cases]:  # one pass over the modules
+        for m in body:
+            if isinstance(m, Turtle):
+                stretch = stretch or m.op == "~"
+                table = table or bool(m.value.table)
+                modules_v2 = modules_v2 or m.op == "z"
+            elif isinstance(m, Symbol) and m.paint is not None:
+                modules_v2 = True
+    if stretch:
         return 4
-    if any(isinstance(m, Turtle) and m.value.table for body in bodies for m in body):
+    if table:
         return 3
     v2 = (
-        g.randomize is not None
+        modules_v2
+        or g.randomize is not None
         or bool(g.styles or g.paint or g.order or g.defs or g.verbatim)
         or not all(t.scaled for t in g.terminals)
-        or any(
-            (isinstance(m, Turtle) and m.op == "z") or (isinstance(m, Symbol) and m.paint is not None)
-            for body in bodies
-            for m in body
-        )
     )
     return 2 if v2 else 1
 
