@@ -31,6 +31,7 @@ from lsys_core.hierarchy.clustering import group_indices, mean_shift
 from lsys_core.hierarchy.gain import Ledger, cluster_bounds
 from lsys_core.hierarchy.linear import linear_candidates
 from lsys_core.hierarchy.spaces import PairSpace
+from lsys_core.hierarchy.spacing import spacing_cap
 from lsys_core.parallel import submit
 
 __all__ = ["find_candidates"]
@@ -67,6 +68,9 @@ def find_candidates(
     key = space_key(sym, ps)
     th = np.angle(ps.A)
     xy, ang, scale = _bandwidths(tol, size, ps, ledger)
+    terminal_sizes = ctx.sizes()[: ctx.n_terminals]
+    floor = tol.xy * float(np.median(terminal_sizes)) if terminal_sizes.size else 0.0
+    xy = np.minimum(xy, spacing_cap(ps, key, sym[ps.src] >= ctx.n_terminals, sym.size, floor))
     emb = np.column_stack(
         [
             ps.B.real / xy,
@@ -80,7 +84,9 @@ def find_candidates(
     prox = proximity(ps, sym.size, radius)
     # The linear sequences (clusters D) need nothing from the clusters C: found beside them.
     linear = (
-        submit(linear_candidates, ctx, sym, ps, prox, size, key, ledger) if len(ps) <= BESIDE_PAIRS else None
+        submit(linear_candidates, ctx, sym, ps, prox, size, xy, key, ledger)
+        if len(ps) <= BESIDE_PAIRS
+        else None
     )
     labels, _ = mean_shift(emb)
     if ledger is not None:
@@ -122,7 +128,11 @@ def find_candidates(
         out[k] = replace(out[k], l=_alternation_length(cl.succ, by_space.get(cl.space[::-1], [])))
     same = {k: v for k, v in by_space.items() if k[0] == k[1]}
     out += branch_candidates(ps, same, prox, n_nodes)
-    out += linear.result() if linear is not None else linear_candidates(ctx, sym, ps, prox, size, key, ledger)
+    out += (
+        linear.result()
+        if linear is not None
+        else linear_candidates(ctx, sym, ps, prox, size, xy, key, ledger)
+    )
     return out
 
 

@@ -41,6 +41,9 @@ class Context(Protocol):
     @property
     def tol(self): ...  # a Tolerance: xy (relative to size), angle (degrees), scale (log)
 
+    @property
+    def n_terminals(self) -> int: ...  # symbols 0 … n_terminals-1 are terminals
+
     def sizes(self) -> np.ndarray: ...
 
     def phi(self, si: int, sj: int) -> float: ...

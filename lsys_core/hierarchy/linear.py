@@ -35,19 +35,21 @@ def linear_candidates(
     ps: PairSpace,
     prox: np.ndarray,
     size: np.ndarray,
+    xy: np.ndarray,
     key: np.ndarray,
     ledger: Ledger | None = None,
 ) -> list[LinearCandidate]:
     """Sequences whose α and β change by a constant step (clusters D in the (d, s) subspace).
 
-    With a ``ledger``, clusters that cannot shorten the description are skipped.
+    ``size`` is every pair's source size and ``xy`` its translation bandwidth.  With a
+    ``ledger``, clusters that cannot shorten the description are skipped.
     """
     tol = ctx.tol
     ok = (ps.d / size > 0.1) & (sym[ps.src] == sym[ps.dst])
     if ok.sum() < 2:
         return []
     sel = np.flatnonzero(ok)
-    emb = np.column_stack([ps.d[sel] / (size[sel] * tol.xy), np.log(ps.s[sel]) / tol.scale, key[sel] * 1e7])
+    emb = np.column_stack([ps.d[sel] / xy[sel], np.log(ps.s[sel]) / tol.scale, key[sel] * 1e7])
     labels, _ = mean_shift(emb)
     if ledger is not None:
         hopeless = cluster_bounds(ledger, labels, ps.src[sel], ps.dst[sel]) <= 0.0

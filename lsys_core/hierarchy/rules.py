@@ -87,6 +87,10 @@ class _Context:
     table: SymbolTable
     tol: Tolerance
 
+    @property
+    def n_terminals(self) -> int:
+        return self.table.n_terminals
+
     def sizes(self) -> np.ndarray:
         return self.table.sizes
 
