@@ -40,8 +40,9 @@ SCALES_PER_OCTAVE = 16
 MIN_USES = 8
 #: ... and at most this many are drawn for one frame (the rest of its instances are drawn as paths) ...
 NEW_PER_FRAME = 64
-#: ... and most kept by one :class:`Sprites` (all are dropped when it is full).
-CACHE_SIZE = 8192
+#: ... and most painted pixels kept by one :class:`Sprites`, 8 bytes each (all are dropped when
+#: it is full): a few hundred large sprites, thousands of small ones.
+CACHE_PIXELS = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -58,7 +59,7 @@ class Stamp:
         Each stamped instance's sprite: an index into ``start`` and ``count``.
     start, count : ndarray of intp
         Where each sprite's pixels are in ``dy``, ``dx`` and ``color``.
-    dy, dx : ndarray of intp
+    dy, dx : ndarray of int16
         Pixel offsets from the origin.
     color : ndarray of uint32
         Pixel values (premultiplied RGBA bytes, opaque).
@@ -101,6 +102,7 @@ class Sprites:
         self._sprites: dict[
             tuple[int, int, int, int, bool], tuple[object, tuple[np.ndarray, ...] | None]
         ] = {}
+        self._pixels = 0  # painted pixels of the kept sprites
 
     def plan(self, terms, symbol, da, db, sscale, idx, highlight, hairline: float) -> Stamp | None:
         """Return the :class:`Stamp` of the instances ``idx`` that can be stamped (None: none).
@@ -135,8 +137,9 @@ class Sprites:
         key = ((sym.astype(np.int64) << 22 | (step + 2**21)) << 10 | angle) << 1 | lit
         keys, which = np.unique(key, return_inverse=True)
         which = which.reshape(-1)
-        if len(self._sprites) + keys.size > CACHE_SIZE:
+        if self._pixels > CACHE_PIXELS:
             self._sprites.clear()
+            self._pixels = 0
         parts: list[tuple[np.ndarray, ...]] = []
         made = 0
         usable = np.ones(keys.size, bool)
@@ -153,6 +156,7 @@ class Sprites:
                     parts.append(_NONE)
                     continue
                 entry = self._sprites[(id(term), q, k, n, h)] = (term, _draw_sprite(term, q, k, n, h))
+                self._pixels += entry[1][0].size if entry[1] is not None else 0
                 made += 1
             sprite = entry[1]
             if sprite is None:
@@ -181,7 +185,7 @@ class Sprites:
         )
 
 
-_NONE: tuple[np.ndarray, ...] = (np.zeros(0, np.intp), np.zeros(0, np.intp), np.zeros(0, np.uint32))
+_NONE: tuple[np.ndarray, ...] = (np.zeros(0, np.int16), np.zeros(0, np.int16), np.zeros(0, np.uint32))
 
 
 def _stampable(term) -> bool:
@@ -224,4 +228,4 @@ def _draw_sprite(term, step: int, angle: int, turns: int, lit: bool) -> tuple[np
         return None
     dy, dx = np.nonzero(painted)
     color = pixels.view(np.uint32).reshape(size, size)[painted]
-    return (dy - half).astype(np.intp), (dx - half).astype(np.intp), color.copy()
+    return (dy - half).astype(np.int16), (dx - half).astype(np.int16), color.copy()
