@@ -82,7 +82,11 @@ class Canvas(CanvasNavigation, QWidget):
         self.overlay: Any = None
         self._overlay_drag = False
         self.runner = LatestRunner(
-            render_frame, name="lsys-render", prepare=self._assign_surface, parent=self
+            render_frame,
+            name="lsys-render",
+            prepare=self._assign_surface,
+            finish_running=lambda req: req.draft and self._draft_now(),  # drafts keep coming in a drag
+            parent=self,
         )
         self.runner.resultReady.connect(self._on_frame)
         self.runner.failed.connect(self._on_render_failed)

@@ -88,6 +88,7 @@ class Document(DocumentFiles, QObject):
         self._randomize: Any = None
 
         self.rules = RulesModel(self)
+        self.rules.deriver.finish_running = lambda _request: self.interactive  # a drag's frames keep coming
         for name in ("textChanged", "grammarChanged", "grammarError", "drawingChanged", "message"):
             getattr(self.rules, name).connect(getattr(self, name))
         self.rules.grammarChanged.connect(self._check_randomize)

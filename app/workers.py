@@ -80,6 +80,11 @@ class LatestRunner(QObject):
     prepare : callable, optional
         ``prepare(request) -> request``, called on the UI thread just before a job starts, to
         complete the snapshot with resources that depend on what is on screen at that moment.
+    finish_running : callable, optional
+        ``finish_running(request) -> bool`` of the running job's request: when it is true (a
+        draft during a drag), a new request does not cancel that job, and its result is still
+        delivered; the newest request starts when it ends.  So frames keep coming while the pointer moves faster than they are made
+        (cancelling them, a fast drag showed nothing until the pointer stopped).
 
     Signals
     -------
@@ -108,11 +113,13 @@ class LatestRunner(QObject):
         debounce_ms: int = 0,
         name: str = "worker",
         prepare: Callable[[Any], Any] | None = None,
+        finish_running: Callable[[], bool] | None = None,
         parent: QObject | None = None,
     ) -> None:
         super().__init__(parent)
         self._compute = compute
         self._prepare = prepare
+        self.finish_running: Callable[[Any], bool] = finish_running or (lambda _request: False)
         self._name = name
         self._generation = 0
         self._pending: tuple[int, Any] | None = None
@@ -147,7 +154,7 @@ class LatestRunner(QObject):
             return
         self._generation += 1
         self._pending = (self._generation, request)
-        if self._running is not None:
+        if self._running is not None and not self.finish_running(self._running.request):
             self._running.token.cancel()
         if immediate or self._timer.interval() <= 0:
             self._timer.stop()
@@ -240,8 +247,10 @@ class LatestRunner(QObject):
             self.progress.emit(stage, fraction)
 
     def _on_done(self, generation: int, result: Any) -> None:
+        job = self._running
         newest = self._finish(generation)
-        if newest:
+        finished = job is not None and job.generation == generation and self._pending is not None
+        if newest or (finished and self.finish_running(job.request)):  # (a drag's draft: shown)
             self._update_busy()
             self.resultReady.emit(result)
         self._after()

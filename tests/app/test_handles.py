@@ -5,6 +5,7 @@ from __future__ import annotations
 import cmath
 import math
 
+import numpy as np
 import pytest
 from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
 from PySide6.QtGui import QMouseEvent
@@ -151,3 +152,32 @@ def test_a_drag_shows_drafts_of_the_new_step_and_the_text_follows_paced(helix, q
     assert helix.rules_panel.text() == doc.text != before and not helix.pacing.pending
     assert doc.undo_stack.count() == 1
     assert GESTURE_FOLLOW_MS > 0
+
+
+def test_moves_faster_than_frames_still_show_frames(helix, qtbot, wait_idle):
+    """A move that comes while the previous one is still derived does not cancel it: its
+    drawing is shown, then the newest one (a fast drag keeps showing frames)."""
+    doc, canvas = helix.doc, helix.canvas
+    drawings = []
+    doc.rules.deriver.resultReady.connect(drawings.append)
+    h = helix.handles.handles
+    start = _widget_point(helix, h.b1)
+    QTest.mousePress(canvas, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, start)
+    for dx in (6, 12):  # back to back: the first derivation is still running at the second move
+        p = start + QPoint(dx, 0)
+        event = QMouseEvent(
+            QEvent.Type.MouseMove,
+            QPointF(p),
+            QPointF(canvas.mapToGlobal(p)),
+            Qt.MouseButton.NoButton,
+            Qt.MouseButton.LeftButton,
+            Qt.KeyboardModifier.NoModifier,
+        )
+        QApplication.sendEvent(canvas, event)
+    assert doc.rules.deriver.running
+    qtbot.waitUntil(lambda: not doc.rules.deriver.busy, timeout=60_000)
+    QTest.mouseRelease(canvas, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, p)
+    wait_idle(helix)
+    assert len(drawings) == 2 and drawings[-1] is doc.drawing
+    assert not np.allclose(drawings[0].b, drawings[1].b)
+    assert doc.undo_stack.count() == 1
