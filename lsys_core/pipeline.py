@@ -64,8 +64,11 @@ EXACT_PLACEMENT = 1e-4
 #: and rounds the rules' numbers within this share of its tolerance.
 SYMMETRIZE_SHAPES = 2.0
 SYMMETRIZE_SNAP = 0.5
-#: Scenes with more elements than this try fewer relaxed tolerances (see :func:`_factors`).
+#: Scenes with more elements than this try fewer relaxed tolerances (see :func:`_tries`).
 LARGE_SCENE = 1000
+#: The noise floor of the clustering bandwidths in the try that has one, as a share of the
+#: tolerance (see :class:`~lsys_core.hierarchy.rules.Tolerance`).
+NOISE_FLOOR = 0.5
 #: The tolerance of :func:`symmetrize`, whose purpose is to move elements onto a regular pattern
 #: (share of the diagonal; the user's tolerance if larger).
 SYMMETRIZE_ERROR = 0.03
@@ -81,10 +84,15 @@ def _shape_similarity(inst: Instancing, cancel: CancelToken | None) -> np.ndarra
     return terminal_similarity(inst.terminals, cancel=cancel)
 
 
-def _factors(settings: InferenceSettings, symmetrizing: bool, n: int) -> list[float]:
-    """Bandwidth factors to try: the user's tolerance first, then relaxed ones.
+def _tries(settings: InferenceSettings, symmetrizing: bool, n: int) -> list[Tolerance]:
+    """Clustering bandwidths to try: the user's tolerance first, then relaxed ones.
 
-    Large scenes try fewer relaxed factors: each try is a whole rule generation.
+    After the first, a try with the bandwidths' noise floor (``Tolerance.length``,
+    :data:`NOISE_FLOOR`): copies drawn by hand, a little off in size and place, pair up as
+    one repetition.  Like every try it is kept only when its grammar is the shortest (minimum
+    description length), so drawings where the floor merges distinct transforms keep the
+    grammar without it.  Large scenes try fewer relaxed factors and no floor: each try is a
+    whole rule generation.
     """
     steps: tuple[float, ...]
     if symmetrizing:
@@ -93,7 +101,13 @@ def _factors(settings: InferenceSettings, symmetrizing: bool, n: int) -> list[fl
         steps = (1.0, 3.0, 5.0, 9.0, 15.0)
     else:
         steps = (1.0, 5.0)
-    return [settings.tolerance * f for f in steps]
+    tries = []
+    for f in steps:
+        tol = Tolerance().scaled(settings.tolerance * f)
+        tries.append(tol)
+        if n <= LARGE_SCENE:
+            tries.append(replace(tol, length=NOISE_FLOOR * settings.tolerance * f))
+    return tries
 
 
 def _instancing(scene: Scene, settings: InferenceSettings, tolerance: float, cancel, progress) -> Instancing:
@@ -282,7 +296,7 @@ def rules_from_analysis(
     copies = inst.stretch_base if inst.stretch_base is not None else np.full(len(inst.terminals), -1)
     drawn = tuple(t for t, c in zip(inst.terminals, copies, strict=True) if c < 0)
     best: tuple[Grammar, Hierarchy, float, float, Drawing] | None = None
-    for factor in _factors(settings, symmetrizing, len(scene.elements)):
+    for tol in _tries(settings, symmetrizing, len(scene.elements)):
         check(cancel)
         hier = build_hierarchy(
             [t.name for t in inst.terminals],
@@ -293,7 +307,7 @@ def rules_from_analysis(
             analysis.center,
             analysis.radius,
             weights=weights,
-            tol=Tolerance().scaled(factor),
+            tol=tol,
             similarity=analysis.shape_similarity,
             precision=prec,
             tolerance=limit,
@@ -322,7 +336,7 @@ def rules_from_analysis(
             break  # every element is explained by repetitions: no need to relax
         if hier.levels == 0 and len(scene.elements) > LARGE_SCENE:
             break  # nothing repeats at all in a large scene: relaxing would only find chance
-    assert best is not None  # _factors is never empty and the first try is always kept
+    assert best is not None  # _tries is never empty and the first try is always kept
     grammar, hier, error, bits, drawing = best
     stages["reproduction_error"] = reproduction_error(inst, sizes, drawing) / diag
     t = time.perf_counter()

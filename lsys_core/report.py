@@ -81,10 +81,12 @@ def _matched(inst: Instancing, sizes: np.ndarray, drawing) -> tuple[np.ndarray, 
 
     Each input element is matched to the nearest derived instance of its terminal (by
     position, and by rotation and scale at the shape's radius: copies turned about one point
-    share their position).
+    share their position).  Turns a shape's symmetry hides do not count: a line turned by
+    180° is the same line.
     """
     a_out = np.zeros_like(inst.a)
     b_out = np.zeros_like(inst.b)
+    order = inst.symmetry
     for g in range(len(inst.terminals)):
         mine = np.flatnonzero(inst.group == g)
         theirs = np.flatnonzero(drawing.symbol == g)
@@ -93,13 +95,27 @@ def _matched(inst: Instancing, sizes: np.ndarray, drawing) -> tuple[np.ndarray, 
         if mine.size == 0:
             continue
 
-        def poses(a: np.ndarray, b: np.ndarray, size: float = float(sizes[g])) -> np.ndarray:
-            return np.column_stack([b.real, b.imag, size * a.real, size * a.imag])
+        def poses(
+            a: np.ndarray, b: np.ndarray, size: float = float(sizes[g]), k: int = int(order[g])
+        ) -> np.ndarray:
+            # k-fold symmetric: the turn counted modulo 2π/k (its k-th power), at the rim's speed
+            turn = np.abs(a) * (np.exp(1j * k * np.angle(a)) / k if k > 0 else 1.0)
+            return np.column_stack([b.real, b.imag, size * turn.real, size * turn.imag])
 
         ta, tb = drawing.a[theirs], drawing.b[theirs]
         _, j = cKDTree(poses(ta, tb)).query(poses(inst.a[mine], inst.b[mine]))
-        a_out[mine], b_out[mine] = ta[j], tb[j]
+        a_out[mine], b_out[mine] = _same_turn(ta[j], inst.a[mine], int(order[g])), tb[j]
     return a_out, b_out
+
+
+def _same_turn(a: np.ndarray, like: np.ndarray, k: int) -> np.ndarray:
+    """Poses ``a`` turned by the multiple of ``2π/k`` that brings them nearest ``like`` (they draw the same)."""
+    if k == 1:
+        return a
+    turn = np.angle(like / a)
+    if k > 1:
+        turn = np.round(turn * k / (2 * np.pi)) * 2 * np.pi / k
+    return a * np.exp(1j * turn)
 
 
 def _displacements(inst: Instancing, sizes: np.ndarray, drawing) -> np.ndarray:

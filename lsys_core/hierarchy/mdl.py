@@ -272,9 +272,9 @@ def table_bits(prec: Precision, values, op: str, lever: float | None = None) -> 
     """Bits of a table value ``[v0, v1, …]`` of turtle command ``op``: its length, its smallest
     entry at full precision, then every entry within the table's range.
 
-    Distances are measured in document units, scales as ``ln s`` times ``lever`` (the radius of
-    the shape they scale, default the diagonal) and angles as turns of the diagonal, so each
-    entry costs ``log2(range / eps + 1)``: a table of nearly equal values is cheap.
+    Distances are measured in document units, scales as ``ln s`` and angles as turns, both times
+    ``lever`` (the radius of what they scale or turn, default the diagonal), so each entry costs
+    ``log2(range / eps + 1)``: a table of nearly equal values is cheap.
     """
     v = np.asarray(values, dtype=float)
     reach = prec.diagonal if lever is None else float(lever)
@@ -283,7 +283,7 @@ def table_bits(prec: Precision, values, op: str, lever: float | None = None) -> 
     elif op in ("f", "~"):
         first = prec.length_bits
     else:
-        v, first = np.radians(v) * prec.diagonal, prec.angle_bits()
+        v, first = np.radians(v) * reach, prec.angle_bits(reach)
     spread = float(np.ptp(v)) if v.size else 0.0
     return float(count_bits(v.size)) + first + v.size * math.log2(spread / prec.eps + 1.0)
 
