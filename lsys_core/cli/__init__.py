@@ -28,6 +28,7 @@ from lsys_core.cli.args import build_parser
 from lsys_core.cli.commands import Progress, run_command
 from lsys_core.errors import LsysError
 from lsys_core.io import OutputClosed
+from lsys_core.parallel import keep_freed_memory
 from lsys_core.quoting import printable
 
 __all__ = ["main"]
@@ -61,6 +62,7 @@ def _settle_stdout() -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the ``lsys`` command line; returns the exit status."""
     args = build_parser().parse_args(argv)
+    keep_freed_memory()  # the command's process is ours: reuse freed arrays (see the function)
     try:
         return _run(args)
     finally:
