@@ -84,15 +84,16 @@ def _shape_similarity(inst: Instancing, cancel: CancelToken | None) -> np.ndarra
     return terminal_similarity(inst.terminals, cancel=cancel)
 
 
-def _tries(settings: InferenceSettings, symmetrizing: bool, n: int) -> list[Tolerance]:
+def _tries(settings: InferenceSettings, symmetrizing: bool, n: int, drawn_by_hand: bool) -> list[Tolerance]:
     """Clustering bandwidths to try: the user's tolerance first, then relaxed ones.
 
-    After the first, a try with the bandwidths' noise floor (``Tolerance.length``,
-    :data:`NOISE_FLOOR`): copies drawn by hand, a little off in size and place, pair up as
-    one repetition.  Like every try it is kept only when its grammar is the shortest (minimum
+    Each factor is tried also with the bandwidths' noise floor (``Tolerance.length``,
+    :data:`NOISE_FLOOR`): copies drawn by hand, a little off in size and place, pair up as one
+    repetition.  Like every try it is kept only when its grammar is the shortest (minimum
     description length), so drawings where the floor merges distinct transforms keep the
-    grammar without it.  Large scenes try fewer relaxed factors and no floor: each try is a
-    whole rule generation.
+    grammar without it.  The floor measures how far copies' outlines deviate from their
+    terminal: without ``drawn_by_hand`` (every copy exact) it is not tried.  Large scenes try
+    fewer relaxed factors and no floor: each try is a whole rule generation.
     """
     steps: tuple[float, ...]
     if symmetrizing:
@@ -105,7 +106,7 @@ def _tries(settings: InferenceSettings, symmetrizing: bool, n: int) -> list[Tole
     for f in steps:
         tol = Tolerance().scaled(settings.tolerance * f)
         tries.append(tol)
-        if n <= LARGE_SCENE:
+        if n <= LARGE_SCENE and drawn_by_hand:
             tries.append(replace(tol, length=NOISE_FLOOR * settings.tolerance * f))
     return tries
 
@@ -296,7 +297,7 @@ def rules_from_analysis(
     copies = inst.stretch_base if inst.stretch_base is not None else np.full(len(inst.terminals), -1)
     drawn = tuple(t for t, c in zip(inst.terminals, copies, strict=True) if c < 0)
     best: tuple[Grammar, Hierarchy, float, float, Drawing] | None = None
-    for tol in _tries(settings, symmetrizing, len(scene.elements)):
+    for tol in _tries(settings, symmetrizing, len(scene.elements), bool(np.any(shape_dev > 0))):
         check(cancel)
         hier = build_hierarchy(
             [t.name for t in inst.terminals],

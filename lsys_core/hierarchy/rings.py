@@ -247,25 +247,35 @@ def _values(
     else:
         beta = beta[0] + (beta - beta[0] + 180.0) % 360.0 - 180.0
     values = np.column_stack([alpha, d, s, beta])
-    # the numbers whose mid value keeps every copy within its slack are written once
     sigma = abs(a[0])
-    mid = (values.max(0) + values.min(0)) / 2
     lever = size * sigma * s
-    err = np.column_stack(
-        [
-            sigma * d * np.radians(np.abs(alpha - mid[_ALPHA])),
-            sigma * np.abs(d - mid[_D]),
-            lever * np.abs(np.log(s / mid[_S])),
-            lever * np.radians(np.abs(beta - mid[_BETA])),
-        ]
-    )
+
+    def errors(at: np.ndarray) -> np.ndarray:
+        """How far every copy moves when each number is written once as ``at``."""
+        return np.column_stack(
+            [
+                sigma * d * np.radians(np.abs(alpha - at[_ALPHA])),
+                sigma * np.abs(d - at[_D]),
+                lever * np.abs(np.log(s / at[_S])),
+                lever * np.radians(np.abs(beta - at[_BETA])),
+            ]
+        )
+
+    # a number written once is the value most copies have (the median: the copies it moves
+    # move least in all), or the mid value (the farthest copy moves least) when only that fits
+    mid = (values.max(0) + values.min(0)) / 2
+    median = np.median(values, axis=0)
+    err_mid, err_median = errors(mid), errors(median)
     budget = (1.0 - 4 * ROUNDING) * float(np.min(nodes.slack[idx]))
     constant = np.zeros(4, bool)
     used = np.zeros(idx.size)
-    for col in np.argsort(err.max(0), kind="stable"):
-        if np.max(used + err[:, col]) <= budget:
-            constant[col] = True
-            used += err[:, col]
+    for col in np.argsort(err_mid.max(0), kind="stable"):
+        for at, err in ((median, err_median), (mid, err_mid)):
+            if np.max(used + err[:, col]) <= budget:
+                constant[col] = True
+                used += err[:, col]
+                mid[col] = at[col]
+                break
     values = np.where(constant[None, :], mid[None, :], values)
     room = ROUNDING * float(np.min(nodes.slack[idx]))
     reach = sigma * float(np.max(d))
