@@ -317,7 +317,8 @@ def _tabulate(
             if not ring_shortens(prec, table, ring, ring_rule(table, ring, "T"), nodes):
                 continue
             name = table.new_name("P")
-            book.add(ring_rule(table, ring, name), f"{name}: a ring of {ring.steps} nodes (table)")
+            tabled = " (table)" if not ring.constant.all() else ""
+            book.add(ring_rule(table, ring, name), f"{name}: a ring of {ring.steps} nodes{tabled}")
             groups.append(ring.nodes)
             syms.append(table.symbol(name, ring.steps - 1))
             starts.append((ring.frame, ring.center))

@@ -91,7 +91,7 @@ def test_five_copies_of_slightly_different_sizes_on_a_ring_are_one_sequence(shap
     r = infer(sc)
     # one rule: a sequence with one step, or a ring with a table of every copy's deviation
     assert re.fullmatch(
-        r"P1: (1 sequences of [A-Z]+, lengths \[5\]|a ring of 5 nodes \(table\))", r.log[0]
+        r"P1: (1 sequences of [A-Z]+, lengths \[5\]|a ring of 5 nodes( \(table\))?)", r.log[0]
     ), r.log
     assert r.max_deviation <= r.tolerance  # measured on the outlines
     # sampled at 8 points a segment, 2 units apart on a leaf: the samples' distance is coarser

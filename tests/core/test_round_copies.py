@@ -71,7 +71,8 @@ def test_a_ring_of_hand_drawn_dots_turned_at_random_is_one_ring_rule(seed: int) 
     r = infer(sc)
     assert len(r.grammar.terminals) == 2  # the dots share one terminal, the frame has its own
     assert r.instancing.symmetry[r.instancing.group[0]] == 0  # round within the tolerance
-    assert r.log[0] == "P1: 1 sequences of A, lengths [5]", r.log
+    # one rule: a sequence, or a ring drawn at one distance from its centre (no table needed)
+    assert r.log[0] in ("P1: 1 sequences of A, lengths [5]", "P1: a ring of 5 nodes"), r.log
     assert r.explained == pytest.approx(5 / 6)
     assert r.max_deviation <= r.tolerance
     assert hausdorff_rel(sc, drawing_scene(derive(r.grammar))) <= 0.005
