@@ -256,3 +256,20 @@ def test_restore_reloads_the_input_in_the_background(qtbot, corpus, inference_pr
     assert doc.scene_path == str(helix) and doc.settings.wh == 0.5 and doc.text == state["text"]
     assert doc.result is None  # no inference ran: the restored rules stay
     doc.shutdown()
+
+
+def test_a_typed_weight_starts_at_once_and_a_slider_drag_after_a_pause(window, corpus, wait_idle):
+    """A value typed into a spin box is one edit: inference starts without the debounce; the
+    steps of a slider drag wait for a pause (each would cancel the one before)."""
+    window.open_path(str(corpus("helix.svg")))
+    wait_idle(window)
+    doc, row = window.doc, window.inference_panel.rows["wh"]
+    row.spin.setValue(0.5)
+    assert doc.inference.runner.running  # started in the same turn
+    wait_idle(window)
+    row.slider.setSliderDown(True)
+    row.slider.setValue(row.slider.value() + 100)
+    assert doc.interactive and doc.inference.runner.busy and not doc.inference.runner.running
+    row.slider.setSliderDown(False)
+    wait_idle(window)
+    assert doc.undo_stack.count() == 2
