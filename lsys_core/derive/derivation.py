@@ -31,7 +31,13 @@ from lsys_core.derive.model import Calls, Drawing
 from lsys_core.derive.order import Items, string_positions
 from lsys_core.derive.paint import paint_z, resolve_styles
 from lsys_core.derive.stretched import stretched
-from lsys_core.derive.turtle import Interpreter, case_masks, chain_frames, segmented_exclusive_cumsum
+from lsys_core.derive.turtle import (
+    Interpreter,
+    case_masks,
+    chain_frames,
+    segmented_exclusive_cumsum,
+    spread,
+)
 from lsys_core.errors import LimitError
 from lsys_core.grammar.model import COND_EQ0, COND_GT0, Grammar, Randomize
 
@@ -65,16 +71,6 @@ class Trace:
     slots: tuple[tuple[str, int, int], ...]
 
 
-def _spread(x, dtype, shape: tuple[int, ...]) -> np.ndarray:
-    """``x`` as an array of ``dtype`` and ``shape``: itself when it is one, else broadcast (read-only).
-
-    ``np.broadcast_to`` costs ~10 µs even when nothing is to broadcast: a derivation of 240
-    small rules spent a third of its time in it.
-    """
-    arr = np.asarray(x, dtype)
-    return arr if arr.shape == shape else np.broadcast_to(arr, shape)
-
-
 class _Emitter:
     """Collect terminal instances in batches and enforce the element limit."""
 
@@ -99,13 +95,13 @@ class _Emitter:
                 np.full(n, term, np.int32),
                 a,
                 b,
-                _spread(z, complex, (n,)),
+                spread(z, complex, (n,)),
                 np.full(n, rule, np.int32),
-                _spread(m, np.int64, (n,)),
+                spread(m, np.int64, (n,)),
                 np.full(n, slot, np.int64),
                 np.full(n, paint, np.int32),
-                _spread(parent, np.int64, (n,)),
-                _spread(rank, np.int64, (n,)),
+                spread(parent, np.int64, (n,)),
+                spread(rank, np.int64, (n,)),
             )
         )
 
@@ -202,9 +198,9 @@ class _Derivation:
         m = np.asarray(m, np.int64)
         if m.size == 0:
             return
-        parent = _spread(parent, np.int64, m.shape)
-        rank = _spread(rank, np.int64, m.shape)
-        z = _spread(z, complex, m.shape)
+        parent = spread(parent, np.int64, m.shape)
+        rank = spread(rank, np.int64, m.shape)
+        z = spread(z, complex, m.shape)
         if self.grammar.rules[target].parametric:
             keep = m >= 0
             if not keep.all():
@@ -259,8 +255,8 @@ class _Derivation:
             a,
             b,
             z,
-            np.tile(_spread(m, np.int64, (n,)), len(draws)),
-            np.tile(_spread(parent, np.int64, (n,)), len(draws)),
+            np.tile(spread(m, np.int64, (n,)), len(draws)),
+            np.tile(spread(parent, np.int64, (n,)), len(draws)),
             np.repeat(np.array([d[0] for d in draws], np.int64), n),
         )
 

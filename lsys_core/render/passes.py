@@ -298,6 +298,18 @@ def _highlight_paints(antialias: bool, draft: bool):
     return fill, _skia_paint((r, g, b, a), antialias, stroke, width)
 
 
+def highlight_mask(highlight: np.ndarray, n: int) -> np.ndarray:
+    """Return the boolean mask of ``n`` instances that ``highlight`` (indices or mask) selects."""
+    mask = np.zeros(n, dtype=bool)
+    hl = np.asarray(highlight).reshape(-1)
+    if hl.dtype == bool:
+        mask[: min(n, hl.size)] = hl[:n]
+    else:
+        hl = hl.astype(np.intp)
+        mask[hl[(hl >= 0) & (hl < n)]] = True
+    return mask
+
+
 def draw_highlight(canvas, terms, symbol, da, db, mask, antialias: bool) -> None:
     """Draw the selected instances on top in the :data:`HIGHLIGHT` colour (full mode).
 

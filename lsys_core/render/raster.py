@@ -57,6 +57,7 @@ from lsys_core.render.passes import (
     batch_path,
     draw_draft,
     draw_highlight,
+    highlight_mask,
 )
 from lsys_core.render.paths import (
     _geometry,
@@ -213,7 +214,7 @@ class Renderer:
             db = s * pb + complex(tx, ty)
         visible = self._visible(terms, symbol, da, db, sscale, width, height)
         visible[kept.served] = False  # gradient-painted: drawn by kept, at their places
-        mask = None if highlight is None else _mask(highlight, n)
+        mask = None if highlight is None else highlight_mask(highlight, n)
         if draft:  # kept content placed before every instance goes under them, the rest on top
             kept.draw(canvas, np.flatnonzero(kept.orders == 0).tolist(), (s, tx, ty))
             stamp = self._sprites.plan(
@@ -299,18 +300,6 @@ class Renderer:
         """Draw the selected instances on top in the highlight colour (full mode)."""
         self._canvas.resetMatrix()
         draw_highlight(self._canvas, terms, symbol, da, db, mask, antialias)
-
-
-def _mask(highlight: np.ndarray, n: int) -> np.ndarray:
-    """Return the boolean mask of ``n`` instances that ``highlight`` (indices or mask) selects."""
-    mask = np.zeros(n, dtype=bool)
-    hl = np.asarray(highlight).reshape(-1)
-    if hl.dtype == bool:
-        mask[: min(n, hl.size)] = hl[:n]
-    else:
-        hl = hl.astype(np.intp)
-        mask[hl[(hl >= 0) & (hl < n)]] = True
-    return mask
 
 
 def _unpremultiply(pixels: np.ndarray) -> np.ndarray:
