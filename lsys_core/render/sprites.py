@@ -76,22 +76,43 @@ class Stamp:
     color: np.ndarray
 
     def apply(self, pixels: np.ndarray) -> None:
-        """Copy the sprites into ``pixels`` (``(h, w, 4)`` uint8, C-contiguous), in instance order."""
-        count = self.count[self.sprite]
-        total = int(count.sum())
-        if total == 0:
+        """Copy the sprites into ``pixels`` (``(h, w, 4)`` uint8, C-contiguous), in instance order.
+
+        Instances whose sprite lies inside the image are copied with flat offsets (the pixel
+        offsets of each sprite in rows of the image, made once per sprite); those near the
+        border pixel by pixel, keeping what falls inside.
+        """
+        if self.sprite.size == 0:
             return
         h, w = pixels.shape[:2]
-        first = np.cumsum(count) - count
-        src = np.repeat(self.start[self.sprite] - first, count) + np.arange(total)
-        x = np.repeat(self.x, count) + self.dx[src]
-        y = np.repeat(self.y, count) + self.dy[src]
         flat = pixels.view(np.uint32).reshape(-1)
-        inside = (x >= 0) & (x < w) & (y >= 0) & (y < h)
-        if inside.all():
-            flat[y * w + x] = self.color[src]  # numpy writes in order: later instances on top
-        else:
-            flat[(y * w + x)[inside]] = self.color[src[inside]]
+        reach = np.zeros(self.count.size, np.intp)  # how far each sprite's pixels go from its origin
+        painted = self.count > 0
+        if painted.any():
+            starts = self.start[painted]
+            far = np.maximum(np.abs(self.dx), np.abs(self.dy)).astype(np.intp)
+            reach[painted] = np.maximum.reduceat(far, starts) if far.size else 0
+        r = reach[self.sprite]
+        inside = (self.x >= r) & (self.x < w - r) & (self.y >= r) & (self.y < h - r)
+        offset = self.dy.astype(np.intp) * w + self.dx  # flat offsets, for this image's rows
+        for part, clip in ((inside, False), (~inside, True)):
+            if not part.any():
+                continue
+            sprite = self.sprite[part]
+            count = self.count[sprite]
+            total = int(count.sum())
+            if total == 0:
+                continue
+            first = np.cumsum(count) - count
+            src = np.repeat(self.start[sprite] - first, count) + np.arange(total)
+            if not clip:  # numpy writes in order: later instances on top
+                base = self.y[part] * w + self.x[part]
+                flat[np.repeat(base, count) + offset[src]] = self.color[src]
+                continue
+            x = np.repeat(self.x[part], count) + self.dx[src]
+            y = np.repeat(self.y[part], count) + self.dy[src]
+            keep = (x >= 0) & (x < w) & (y >= 0) & (y < h)
+            flat[(y * w + x)[keep]] = self.color[src[keep]]
 
 
 class Sprites:

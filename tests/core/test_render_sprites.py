@@ -110,3 +110,24 @@ def test_a_sprite_is_drawn_only_for_enough_instances():
     r._sprites.plan = lambda *args: calls.append(plan(*args)) or calls[-1]
     r.draw(drawing, None, False, True)
     assert calls == [None]
+
+
+def test_instances_across_the_border_are_clipped_not_wrapped():
+    """Stamped instances half outside the image paint only their inside part: nothing wraps
+    around to the other side of the image."""
+    k = np.arange(20)
+    drawing = make_drawing(
+        [Terminal("A", "M -6 -3 L 6 -3 L 6 3 L -6 3 Z", "fill:#ff0000")],
+        np.zeros(k.size),
+        np.ones(k.size),
+        1 + 1j * (1 + 10 * k),  # across the left edge (and the top one)
+        (0.0, 0.0, 200.0, 200.0),
+    )
+    stamped = _draft(drawing, True)[:, :, :3]
+    paths = _draft(drawing, False)[:, :, :3]
+    assert (stamped[:, :2] == (255, 0, 0)).all(axis=2).sum() >= 20 * 3  # the half-boxes inside
+    assert (stamped[:, 20:] == 255).all()  # nothing wrapped to the right edge (or the bottom)
+    assert (
+        np.abs(stamped.astype(int) - paths).max(axis=2).astype(bool).sum()
+        <= 0.2 * (paths[..., 1] < 250).sum()
+    )
