@@ -5,7 +5,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 EXAMPLE ?= resources/examples/helix.svg
 
-.PHONY: run test lint bench fuzz package clean
+.PHONY: run test lint bench fuzz package clean bytecode
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -15,7 +15,12 @@ $(STAMP): pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	@touch $(STAMP)
 
-run: $(STAMP)
+# What an installed package has: every module compiled once, not again by each process (tests
+# and benchmarks start hundreds of `lsys` processes; also where PYTHONDONTWRITEBYTECODE is set).
+bytecode: $(STAMP)
+	@$(BIN)/python -m compileall -q lsys_core app > /dev/null
+
+run: $(STAMP) bytecode
 	@$(BIN)/python -m lsys_editor.syscheck
 	$(BIN)/lsys-editor $(EXAMPLE)
 
@@ -25,10 +30,10 @@ lint: $(STAMP)
 	$(BIN)/lint-imports
 	$(BIN)/mypy
 
-test: $(STAMP) lint
+test: $(STAMP) lint bytecode
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q
 
-bench: $(STAMP)
+bench: $(STAMP) bytecode
 	@echo "cores: $$(nproc)"
 	@for f in tests/bench/bench_*.py; do echo "== $$f"; QT_QPA_PLATFORM=offscreen $(BIN)/python $$f || exit 1; done
 
