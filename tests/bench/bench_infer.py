@@ -1,8 +1,9 @@
 """Inference speed at scale: the whole `lsys infer` process on rotating grids of leaves.
 
-Run with `make bench` (or directly).  One line per case: elements, wall seconds, peak memory
-of the process tree (proportional set size, so pages shared between workers count once),
-worker jobs, cores seen, the growth exponent from the previous size, the load average when the
+Run with `make bench` (or directly).  One line per case: elements, wall seconds, CPU seconds
+(user + system of the process and its threads: on a machine shared with other work the wall time
+waits for cores, the CPU time much less), peak memory of the process tree (proportional set
+size, so pages shared between workers count once), worker jobs, cores seen, the growth exponent from the previous size, the load average when the
 case started, and the per-stage seconds of the report.  A last line compares 2 jobs with 1.
 
 Environment: ``BENCH_SIZES`` (default ``1200,20000,50000,100000``), ``BENCH_REPEATS`` (median
@@ -16,6 +17,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -79,12 +81,19 @@ class _Peak(threading.Thread):
             self.peak = max(self.peak, _memory(self.pid))
 
 
-def run_once(svg: Path, tmp: Path, jobs: int) -> tuple[float, float, dict]:
-    """Run ``lsys infer`` once; return wall seconds, peak MiB and the JSON report."""
+def _children_cpu() -> float:
+    """User + system seconds of all waited-for child processes so far."""
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return ru.ru_utime + ru.ru_stime
+
+
+def run_once(svg: Path, tmp: Path, jobs: int) -> tuple[float, float, dict, float]:
+    """Run ``lsys infer`` once; return wall seconds, peak MiB, the JSON report and CPU seconds."""
     rep = tmp / "rep.json"
     env = {**os.environ, "LSYS_JOBS": str(jobs)}
     nice = int(os.environ.get("BENCH_NICE", "5"))
     cmd = [*LSYS, "-q", "infer", str(svg), "-o", str(tmp / "r.lsys"), "--report", str(rep)]
+    cpu = _children_cpu()
     t = time.perf_counter()
     p = subprocess.Popen(
         cmd,
@@ -102,20 +111,26 @@ def run_once(svg: Path, tmp: Path, jobs: int) -> tuple[float, float, dict]:
     peak.join()
     if p.returncode:
         raise SystemExit(err)
-    return wall, peak.peak, json.loads(rep.read_text())
+    return wall, peak.peak, json.loads(rep.read_text()), _children_cpu() - cpu
 
 
-def case(svg: Path, tmp: Path, n: int, jobs: int, repeats: int) -> tuple[float, float, dict, float]:
-    """Median wall seconds, peak MiB, first report and the load average at the start."""
+def case(svg: Path, tmp: Path, n: int, jobs: int, repeats: int) -> tuple[float, float, dict, float, float]:
+    """Median wall seconds, peak MiB, first report, load average at the start, median CPU seconds."""
     load = os.getloadavg()[0]
     runs = [run_once(svg, tmp, jobs) for _ in range(repeats if n <= 5000 else 1)]
-    return statistics.median(r[0] for r in runs), max(r[1] for r in runs), runs[0][2], load
+    return (
+        statistics.median(r[0] for r in runs),
+        max(r[1] for r in runs),
+        runs[0][2],
+        load,
+        statistics.median(r[3] for r in runs),
+    )
 
 
-def line(n: int, sec: float, mib: float, jobs: int, expo: str, load: float, rep: dict) -> str:
+def line(n: int, sec: float, cpu: float, mib: float, jobs: int, expo: str, load: float, rep: dict) -> str:
     stages = " ".join(f"{k}={v:.2f}" for k, v in rep["stages"].items() if k != "reproduction_error")
     return (
-        f"{n:>8} {sec:>8.2f} {mib:>8.0f} {jobs:>4} {cores():>5} {expo:>8} {load:>5.1f} "
+        f"{n:>8} {sec:>8.2f} {cpu:>7.2f} {mib:>8.0f} {jobs:>4} {cores():>5} {expo:>8} {load:>5.1f} "
         f"{len(rep['rules']):>5}  {stages}"
     )
 
@@ -127,7 +142,7 @@ def main() -> None:
     jobs = int(os.environ.get("LSYS_JOBS", "0")) or cores()
     print(f"inference at scale: whole `lsys infer` on a rotating grid of leaves, {cores()} cores seen")
     print(
-        f"{'n':>8} {'seconds':>8} {'peak MiB':>8} {'jobs':>4} {'cores':>5} {'exponent':>8} {'load':>5} {'rules':>5}  stages (s)"
+        f"{'n':>8} {'seconds':>8} {'cpu s':>7} {'peak MiB':>8} {'jobs':>4} {'cores':>5} {'exponent':>8} {'load':>5} {'rules':>5}  stages (s)"
     )
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
@@ -137,10 +152,10 @@ def main() -> None:
         for n in sizes:
             rows, cols = grid_dims(n)
             svgs[n] = write(tmp / f"grid{n}.svg", rotating_grid_svg(rows, cols))
-            sec, mib, rep, load = case(svgs[n], tmp, n, jobs, repeats)
+            sec, mib, rep, load, cpu = case(svgs[n], tmp, n, jobs, repeats)
             m = rows * cols
             expo = f"{math.log(sec / prev[1]) / math.log(m / prev[0]):.2f}" if prev else "-"
-            print(line(m, sec, mib, jobs, expo, load, rep), flush=True)
+            print(line(m, sec, cpu, mib, jobs, expo, load, rep), flush=True)
             prev, results[m] = (m, sec), sec
         big = [m for m in results if m >= 20000]
         if len(big) >= 2:
@@ -152,9 +167,9 @@ def main() -> None:
             svg = svgs.get(speed_n) or write(tmp / f"grid{speed_n}.svg", rotating_grid_svg(rows, cols))
             m = rows * cols
             one = case(svg, tmp, m, 1, 1)
-            print(line(m, one[0], one[1], 1, "-", one[3], one[2]), flush=True)
+            print(line(m, one[0], one[4], one[1], 1, "-", one[3], one[2]), flush=True)
             two = case(svg, tmp, m, 2, 1)
-            print(line(m, two[0], two[1], 2, "-", two[3], two[2]), flush=True)
+            print(line(m, two[0], two[4], two[1], 2, "-", two[3], two[2]), flush=True)
             print(f"speed-up at {m}, 2 jobs vs 1: {one[0] / two[0]:.2f}x")
 
 
