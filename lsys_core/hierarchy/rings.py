@@ -188,8 +188,8 @@ def _ring_of(
     b, a = nodes.b[idx], nodes.a[idx]
     cc = np.array([c])
     mem = np.flatnonzero(_members(b, np.angle(a), np.abs(a), period, cc, _reference(cc, b))[0])
-    if mem.size < MIN_COPIES:
-        return None
+    if mem.size < MIN_COPIES or np.min(np.abs(b[mem] - c)) <= 2 * prec.eps or not np.isfinite(c):
+        return None  # copies at the centre: turned in place, not on a ring (concentric copies)
     ang = np.degrees(np.angle(b[mem] - c))
     order = np.argsort(ang, kind="stable")
     mem, ang = mem[order], ang[order]

@@ -71,3 +71,13 @@ def test_copies_at_random_places_turns_and_sizes_get_no_ring(seed: int) -> None:
     b = rng.uniform(0, 200, 20) + 1j * rng.uniform(0, 200, 20)
     result = infer(scene(place(LEAF, list(zip(a, b, strict=True)))))
     assert not any("ring" in line for line in result.log), result.log
+
+
+def test_copies_turned_in_place_or_stacked_get_no_ring_and_no_error() -> None:
+    turns = np.exp(1j * np.deg2rad([0.0, 72.0, 144.0, 216.0, 288.0]))
+    in_place = [(complex(t), 100 + 100j) for t in turns]  # one centre: no ring has a radius
+    stacked = [(1 + 0j, 40 + 40j)] * 3
+    sc = scene(place(LEAF, in_place), place(HOOK, stacked))
+    result = infer(sc)
+    assert not any("ring" in line for line in result.log), result.log
+    assert result.max_deviation <= result.tolerance
