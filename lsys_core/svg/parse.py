@@ -216,14 +216,14 @@ def _elements(reader: Reader) -> tuple[list[Element], Counter]:
     skips["non-finite or huge coordinates"] += int(bad.sum())
     skips["degenerate (zero size)"] += int(flat.sum())
     cubics.flags.writeable = False
-    ends = starts + counts
+    lows, highs = starts.tolist(), (starts + counts).tolist()
     out = []
     for i in np.flatnonzero(~(bad | flat)).tolist():
         r = recs[i]
         sub = r.path.subpaths
         sub.flags.writeable = False
-        style = ";".join(f"{k}:{v}" for k, v in r.style.items())
-        out.append(Element(cubics[starts[i] : ends[i]], sub, r.path.closed, style, r.source, r.order))
+        style = ";".join(map(":".join, r.style.items()))  # name:value;...
+        out.append(Element(cubics[lows[i] : highs[i]], sub, r.path.closed, style, r.source, r.order))
     return out, skips
 
 

@@ -24,6 +24,7 @@ from lsys_core.svg.values import Viewport, parse_length, to_user
 __all__ = [
     "Geometry",
     "KeepAsIs",
+    "capped_stroke",
     "draws_cap_dots",
     "ellipse_path",
     "polyline_table",
@@ -160,6 +161,13 @@ def _len(el: ET.Element, name: str, vp: Viewport, axis: str, default: float | No
     return to_user(got, vp, axis)
 
 
+def capped_stroke(style: dict[str, str]) -> bool:
+    """Whether a style strokes with caps that show on a zero-length subpath (``round``, ``square``)."""
+    if style.get("stroke", "none").strip().lower() == "none":
+        return False
+    return style.get("stroke-linecap", "butt").strip().lower() in ("round", "square")
+
+
 def draws_cap_dots(style: dict[str, str], table: PathTable | None) -> bool:
     """Whether a stroke draws caps on a zero-length subpath (a dot or a square where it stands).
 
@@ -167,9 +175,7 @@ def draws_cap_dots(style: dict[str, str], table: PathTable | None) -> bool:
     ``round`` or ``square``; the cubic geometry drops such segments, so the caller keeps the
     element as it is.
     """
-    if table is None or table.op.size == 0 or style.get("stroke", "none").strip().lower() == "none":
-        return False
-    if style.get("stroke-linecap", "butt").strip().lower() not in ("round", "square"):
+    if table is None or table.op.size == 0 or not capped_stroke(style):
         return False
     op, pts = table.op, table.pts
     is_move = op == pd.MOVE
@@ -194,11 +200,13 @@ def shape_geometry(
     el: ET.Element,
     tag: str,
     vp: Viewport,
-    path_of: Callable[[str], tuple[ArrayPath, PathTable | None, str | None]],
+    path_of: Callable[[str, bool], tuple[ArrayPath, PathTable | None, str | None]],
+    rows: bool = True,
 ) -> tuple[Geometry | None, str | None]:
     """Read a shape element; return its geometry (None: draws nothing) and why it may be empty.
 
-    ``path_of(d)`` returns the parsed path data (cubics, rows, error).
+    ``path_of(d, rows)`` returns the parsed path data (cubics, rows, error); the rows of a
+    ``<path>`` (for markers and caps) are left out (None) unless ``rows``.
 
     Raises
     ------
@@ -206,7 +214,7 @@ def shape_geometry(
         The shape uses units renderers disagree on.
     """
     if tag == "path":
-        path, table, error = path_of(el.get("d") or "")
+        path, table, error = path_of(el.get("d") or "", rows)
         if error and error.startswith("a number beyond"):
             return Geometry(path, table), "non-finite or huge coordinates"
         return Geometry(path, table), ("malformed path data" if error else None)

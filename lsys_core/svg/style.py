@@ -13,7 +13,7 @@ import functools
 import xml.etree.ElementTree as ET
 
 from lsys_core.svg.colors import parse_color
-from lsys_core.svg.css import StyleSheet, parse_declarations
+from lsys_core.svg.css import Declaration, StyleSheet, parse_declarations
 from lsys_core.svg.tree import Tree
 from lsys_core.svg.values import parse_length, parse_number, parse_numbers
 
@@ -57,6 +57,8 @@ _FONT_SIZES = {
     "xx-small": 3 / 5, "x-small": 3 / 4, "small": 8 / 9, "medium": 1.0,
     "large": 6 / 5, "x-large": 3 / 2, "xx-large": 2.0, "xxx-large": 3.0,
 }  # fmt: skip
+#: Distinct styles each memo of a :class:`Cascade` keeps (it starts again when full).
+MEMO_SIZE = 4096
 #: Font size of the root when none is given (what rsvg and many tools use for ``medium``).
 DEFAULT_FONT_SIZE = 12.0
 
@@ -178,6 +180,9 @@ class Cascade:
         self.tree = tree
         self.sheet = sheet
         self._specified: dict[int, dict[str, str]] = {}
+        self._same: dict[tuple[tuple[str, str], ...], dict[str, str]] = {}
+        self._computed: dict[tuple[int, int, float], tuple[dict, dict, dict[str, str]]] = {}
+        self._attributes: dict[str, tuple[Declaration, ...]] = {}
 
     def specified(self, el: ET.Element) -> dict[str, str]:
         """Return the declared properties of an element after the cascade (cached)."""
@@ -195,15 +200,59 @@ class Cascade:
                 _declare(normal, important, d.name, d.value, d.important)
         style = el.get("style")
         if style:
-            for d in parse_declarations(style):
+            for d in self._style_attribute(style):
                 _declare(normal, important, d.name, d.value, d.important)
         normal.update(important)
+        normal = self._shared(normal)
         self._specified[key] = normal
         return normal
 
+    def _style_attribute(self, text: str) -> tuple[Declaration, ...]:
+        """The declarations of a ``style`` attribute, remembered per text.
+
+        Editors write the same few ``style`` texts on thousands of elements, and reading one
+        with the CSS tokenizer costs tens of microseconds.
+        """
+        got = self._attributes.get(text)
+        if got is None:
+            got = tuple(parse_declarations(text))
+            if len(self._attributes) >= MEMO_SIZE:
+                self._attributes.clear()
+            self._attributes[text] = got
+        return got
+
+    def _shared(self, spec: dict[str, str]) -> dict[str, str]:
+        """One dictionary for equal specified styles (same order), so that identity tells them apart."""
+        items = tuple(spec.items())
+        got = self._same.get(items)
+        if got is None:
+            if len(self._same) >= MEMO_SIZE:
+                self._same.clear()
+            self._same[items] = got = spec
+        return got
+
     def computed(self, el: ET.Element, parent: dict[str, str], root_font: float) -> dict[str, str]:
-        """Fold an element's specified properties onto its parent's computed ones."""
+        """Fold an element's specified properties onto its parent's computed ones.
+
+        The result is shared by the elements with the same specified style under the same parent
+        style (both told apart by identity: :meth:`_shared`); nothing changes a style once made.
+        Children of one group mostly have equal styles: folding each one again took 0.46 of 5.3
+        profiled seconds reading 20,000 leaves, and sharing lets later steps remember what they
+        derive from a style by its identity.
+        """
         spec = self.specified(el)
+        key = (id(parent), id(spec), root_font)
+        got = self._computed.get(key)
+        if got is not None and got[0] is parent and got[1] is spec:
+            return got[2]
+        out = self._fold(spec, parent, root_font)
+        if len(self._computed) >= MEMO_SIZE:
+            self._computed.clear()
+        self._computed[key] = (parent, spec, out)  # holds both, so their ids are not reused
+        return out
+
+    @staticmethod
+    def _fold(spec: dict[str, str], parent: dict[str, str], root_font: float) -> dict[str, str]:
         out = {k: v for k, v in parent.items() if k in INHERITED}
         for name, value in spec.items():
             low = value.lower()

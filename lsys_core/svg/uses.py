@@ -12,7 +12,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 
 from lsys_core.errors import LimitError
-from lsys_core.svg.tree import Tree, href_of, local_name
+from lsys_core.svg.tree import SVG_NS, Tree, href_of, local_name
 
 __all__ = ["check_expansion"]
 
@@ -31,6 +31,10 @@ def check_expansion(tree: Tree, max_elements: int, max_depth: int, name: str) ->
         More than ``max_elements`` elements, or nesting deeper than ``max_depth`` levels,
         once references are expanded.
     """
+    if not _has_use(tree.root):
+        size, height = _tree_size(tree.root)
+        if size <= max_elements and height <= max_depth:
+            return size
     visiting, done = 1, 2
     state: dict[int, int] = {}
     total: dict[int, int] = {}
@@ -67,3 +71,26 @@ def check_expansion(tree: Tree, max_elements: int, max_depth: int, name: str) ->
         total[key], depth[key] = t, d
         state[key] = done
     return total.get(id(tree.root), 1)
+
+
+def _has_use(root: ET.Element) -> bool:
+    """Whether the document has a ``<use>`` (found at the speed of ElementTree's own search)."""
+    return any(next(root.iter(tag), None) is not None for tag in (SVG_NS + "use", "use"))
+
+
+def _tree_size(root: ET.Element) -> tuple[int, int]:
+    """The number of elements drawn in place and their nesting depth, for a document without ``<use>``.
+
+    Without references the expansion is the tree itself, counted a level at a time: the general
+    walk took 0.12 s (6 microseconds per element) reading 20,000 leaves.  Its results are the
+    same; the general walk still tells what is beyond a limit.
+    """
+    size = height = 0
+    level = [root]
+    while level:
+        size += len(level)
+        height += 1
+        level = [
+            c for el in level for c in el if isinstance(c.tag, str) and local_name(c.tag) not in _NOT_IN_FLOW
+        ]
+    return size, height

@@ -132,11 +132,13 @@ class _Reader:
             raise LimitError(f"{self.name} has more than {self.max_elements:,} elements")
         if self.depth > self.max_depth:
             raise LimitError(f"{self.name}: elements are nested more than {self.max_depth} levels deep")
-        self.builder.start(self.fix(tag), {self.fix(k): v for k, v in attrs.items()})
+        if "}" in "".join(attrs):  # attributes in a namespace (most have none: kept as expat made them)
+            attrs = {self.fix(k): v for k, v in attrs.items()}
+        self.builder.start("{" + tag if "}" in tag else tag, attrs)
 
     def end(self, tag: str) -> None:
         self.depth -= 1
-        self.builder.end(self.fix(tag))
+        self.builder.end("{" + tag if "}" in tag else tag)
 
     def entity(self, name, is_parameter, value, base, system_id, public_id, notation) -> None:
         if is_parameter:
