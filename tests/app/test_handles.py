@@ -33,20 +33,25 @@ def _widget_point(window, z: complex) -> QPoint:
     return QPoint(round(x), round(y))
 
 
+def _move_pressed(canvas, p: QPoint) -> None:
+    """Move the mouse, its left button held, to ``p`` on ``canvas``."""
+    event = QMouseEvent(
+        QEvent.Type.MouseMove,
+        QPointF(p),
+        QPointF(canvas.mapToGlobal(p)),
+        Qt.MouseButton.NoButton,
+        Qt.MouseButton.LeftButton,
+        Qt.KeyboardModifier.NoModifier,
+    )
+    QApplication.sendEvent(canvas, event)
+
+
 def _drag(window, start: QPoint, path: list[QPoint]) -> None:
     """Press on ``start``, move the pressed mouse along ``path``, release at its end."""
     canvas = window.canvas
     QTest.mousePress(canvas, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, start)
     for p in path:
-        event = QMouseEvent(
-            QEvent.Type.MouseMove,
-            QPointF(p),
-            QPointF(canvas.mapToGlobal(p)),
-            Qt.MouseButton.NoButton,
-            Qt.MouseButton.LeftButton,
-            Qt.KeyboardModifier.NoModifier,
-        )
-        QApplication.sendEvent(canvas, event)
+        _move_pressed(canvas, p)
     QTest.mouseRelease(canvas, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, path[-1])
 
 
@@ -125,15 +130,7 @@ def test_a_drag_shows_drafts_of_the_new_step_and_the_text_follows_paced(helix, q
     helix.pacing._timer.setInterval(60_000)  # no paced update during this test: only the release's
     for dx in (6, 12, 18):
         p = start + QPoint(dx, 0)
-        event = QMouseEvent(
-            QEvent.Type.MouseMove,
-            QPointF(p),
-            QPointF(canvas.mapToGlobal(p)),
-            Qt.MouseButton.NoButton,
-            Qt.MouseButton.LeftButton,
-            Qt.KeyboardModifier.NoModifier,
-        )
-        QApplication.sendEvent(canvas, event)
+        _move_pressed(canvas, p)
         qtbot.waitUntil(
             lambda: not doc.busy and canvas._frame is not None and canvas._frame.drawing is doc.drawing,
             timeout=10_000,
@@ -165,15 +162,7 @@ def test_moves_faster_than_frames_still_show_frames(helix, qtbot, wait_idle):
     QTest.mousePress(canvas, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, start)
     for dx in (6, 12):  # back to back: the first derivation is still running at the second move
         p = start + QPoint(dx, 0)
-        event = QMouseEvent(
-            QEvent.Type.MouseMove,
-            QPointF(p),
-            QPointF(canvas.mapToGlobal(p)),
-            Qt.MouseButton.NoButton,
-            Qt.MouseButton.LeftButton,
-            Qt.KeyboardModifier.NoModifier,
-        )
-        QApplication.sendEvent(canvas, event)
+        _move_pressed(canvas, p)
     assert doc.rules.deriver.running
     qtbot.waitUntil(lambda: not doc.rules.deriver.busy, timeout=60_000)
     QTest.mouseRelease(canvas, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, p)
