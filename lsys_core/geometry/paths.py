@@ -157,14 +157,15 @@ def arrays_from_table(
     # Subpaths are numbered per path: subtract each path's first subpath number.
     first_sub = np.append(sub, 0)[bounds[:-1]]
     sub = sub - np.repeat(first_sub, np.diff(bounds))
-    out = []
-    sub_lo = 0
-    for p in range(n_paths):
-        a, b = int(bounds[p]), int(bounds[p + 1])
-        n_sub = int(sub[b - 1]) + 1 if b > a else 0
-        out.append(ArrayPath(cub[a:b], sub[a:b], tuple(closed[sub_lo : sub_lo + n_sub])))
-        sub_lo += n_sub
-    return out
+    # Each path's subpath count, and where its flags start, as plain lists: indexing numpy
+    # scalars path by path was most of this function's 3 microseconds per path.
+    n_sub = np.where(bounds[1:] > bounds[:-1], np.append(sub, 0)[np.maximum(bounds[1:] - 1, 0)] + 1, 0)
+    sub_at = np.concatenate([[0], np.cumsum(n_sub)]).tolist()
+    at = bounds.tolist()
+    return [
+        ArrayPath(cub[at[p] : at[p + 1]], sub[at[p] : at[p + 1]], tuple(closed[sub_at[p] : sub_at[p + 1]]))
+        for p in range(n_paths)
+    ]
 
 
 def _convert(

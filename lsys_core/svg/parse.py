@@ -41,6 +41,8 @@ __all__ = ["DEFAULT_MAX_BYTES", "DEFAULT_MAX_DEPTH", "DEFAULT_MAX_ELEMENTS", "lo
 _ABSOLUTE = ("", "px", "pt", "pc", "mm", "cm", "in", "q")
 #: Segments placed at once by :func:`_placed`.
 _BLOCK = 1 << 16
+#: Bytes of cubics :func:`_joined` copies without trying to place them where they are.
+_SMALL_COPY = 32 << 20
 
 
 def _display_name(name: str) -> str:
@@ -267,8 +269,14 @@ def _joined(recs: list[ShapeRecord], counts: np.ndarray) -> np.ndarray:
     placed in place, without a copy (61 MiB for a path of 10^6 segments).  The records' cubics
     are not read again once placed (a hidden record may share a drawn one's piece).  Otherwise
     the cubics are copied.
+
+    A copy of at most :data:`_SMALL_COPY` bytes is made without looking: telling whether the
+    pieces tile the array costs about 2 microseconds a record (40 ms of reading 20,000 leaves,
+    whose copy takes 4 ms and 5 MiB).
     """
     arrays = [r.path.cubics for r in recs]
+    if int(counts.sum()) * 64 <= _SMALL_COPY:
+        return np.concatenate(arrays)
     joined = consecutive(arrays)
     owner = None if joined is None else joined.base
     if (

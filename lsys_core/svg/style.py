@@ -43,6 +43,8 @@ NOT_INHERITED = frozenset(
 PROPERTIES = INHERITED | NOT_INHERITED
 #: Properties that are never presentation attributes (CSS only).
 CSS_ONLY = frozenset({"marker", "font", "transform-origin"})
+#: Properties that are presentation attributes.
+_ATTRIBUTES = PROPERTIES - CSS_ONLY
 
 _ENUMS = {
     "fill-rule": {"nonzero", "evenodd"},
@@ -193,11 +195,12 @@ class Cascade:
         normal: dict[str, str] = {}
         important: dict[str, str] = {}
         for name, value in el.attrib.items():
-            if name in PROPERTIES and name not in CSS_ONLY and valid(name, value):
+            if name in _ATTRIBUTES and valid(name, value):
                 normal[name] = value.strip()
-        for rule in self.sheet.matching(el, self.tree):
-            for d in rule.declarations:
-                _declare(normal, important, d.name, d.value, d.important)
+        if self.sheet.rules:
+            for rule in self.sheet.matching(el, self.tree):
+                for d in rule.declarations:
+                    _declare(normal, important, d.name, d.value, d.important)
         style = el.get("style")
         if style:
             for d in self._style_attribute(style):

@@ -21,6 +21,7 @@ from lsys_core.geometry.paths import ArrayPath
 from lsys_core.svg import group_effects, markers
 from lsys_core.svg.css import StyleSheet
 from lsys_core.svg.declare import DeclarationMemo
+from lsys_core.svg.facts import StyleFacts, StyleFactsMemo
 from lsys_core.svg.masking import Definitions
 from lsys_core.svg.paint import anisotropy
 from lsys_core.svg.pathcache import DEFAULT_MAX_SEGMENTS, PathCache
@@ -31,11 +32,10 @@ from lsys_core.svg.records import (
     VerbatimRecord,
     length_or,
     only_part,
-    paint_order,
     source_names,
     switch_child,
 )
-from lsys_core.svg.shapes import Geometry, KeepAsIs, capped_stroke, draws_cap_dots, shape_geometry
+from lsys_core.svg.shapes import Geometry, KeepAsIs, draws_cap_dots, shape_geometry
 from lsys_core.svg.style import DEFAULT_FONT_SIZE, Cascade
 from lsys_core.svg.tree import Tree, describe, href_of, local_name, shown
 from lsys_core.svg.values import (
@@ -64,17 +64,6 @@ _NOT_DRAWN = frozenset(
 _ANIMATION = frozenset({"animate", "animateMotion", "animateTransform", "animateColor", "set"})
 #: Content kept as is (not geometry to infer rules from).
 _VERBATIM = frozenset({"text", "image", "foreignObject"})
-#: The painting order without a ``paint-order`` (read only).
-_NORMAL_ORDER = paint_order(None)
-
-
-def _has_markers(style: dict[str, str]) -> bool:
-    """Whether a style draws markers on the vertices of a shape that can have them."""
-    for k in ("marker-start", "marker-mid", "marker-end"):
-        v = style.get(k)
-        if v is not None and v.strip().lower() != "none":
-            return True
-    return False
 
 
 @dataclass
@@ -108,6 +97,7 @@ class Reader:
         self.order = 0
         self.root_font = DEFAULT_FONT_SIZE
         self._last_anisotropy: tuple[Matrix, float] | None = None
+        self._facts = StyleFactsMemo()
 
     # -- styles ---------------------------------------------------------------------------------
 
@@ -165,15 +155,16 @@ class Reader:
         if ctx.depth > self.max_depth:
             raise LimitError(f"{self.name}: elements are nested more than {self.max_depth} levels deep")
         style = self.cascade.computed(el, ctx.style, self.root_font)
-        if style.get("display", "inline").strip().lower() == "none":
+        facts = self._facts.get(style)
+        if not facts.displayed:
             return
-        font = float(style.get("font-size", DEFAULT_FONT_SIZE))
+        font = facts.font
         vp = ctx.vp if font == ctx.vp.font_size and font else ctx.vp._replace(font_size=font)
         own = self._transform(el, style, vp)
         ctm = multiply(ctx.ctm, own) if own is not None else ctx.ctm
         # (made directly: ``dataclasses.replace`` cost 0.35 of 5.3 profiled seconds for 20,000 leaves)
         inner = Ctx(ctm, style, vp, ctx.depth + 1, ctx.uses, ctx.chain, ctx.context)
-        if style.get("filter", "none").strip().lower() != "none":
+        if facts.filtered:
             self.keep_as_is(el, ctx, "filter")
             return
         if (
@@ -184,7 +175,7 @@ class Reader:
             self.keep_as_is(el, ctx, "transform-origin: renderers differ")
             return
         if tag in SHAPES:
-            self.shape(el, tag, inner, ctx)
+            self.shape(el, tag, inner, ctx, facts)
             return
         start = len(self.records)
         clip = None
@@ -302,21 +293,19 @@ class Reader:
 
     # -- shapes ---------------------------------------------------------------------------------
 
-    def shape(self, el: ET.Element, tag: str, ctx: Ctx, outer: Ctx) -> None:
-        """Record a drawable shape with what it draws with, then its markers."""
+    def shape(self, el: ET.Element, tag: str, ctx: Ctx, outer: Ctx, facts: StyleFacts) -> None:
+        """Record a drawable shape with what it draws with (``facts`` of its style), then its markers."""
         style = ctx.style
-        wants_markers = tag in _MARKABLE and _has_markers(style)
+        wants_markers = tag in _MARKABLE and facts.markers
         try:
-            geom, reason = shape_geometry(
-                el, tag, ctx.vp, self.paths.get, rows=wants_markers or capped_stroke(style)
-            )
+            geom, reason = shape_geometry(el, tag, ctx.vp, self.paths.get, rows=wants_markers or facts.capped)
         except KeepAsIs as why:
             self.keep_as_is(el, outer, str(why))
             return
         if geom is None:
             self.skips[reason or "degenerate (zero size)"] += 1
             return
-        if style.get("visibility", "visible").strip().lower() != "visible":
+        if not facts.visible:
             if geom.path.cubics.shape[0]:  # draws nothing, yet counts in its groups' boxes
                 self.records.append(ShapeRecord(geom.path, ctx.ctm, {}, "", -1, hidden=True))
             return
@@ -335,8 +324,7 @@ class Reader:
         if stroked and self._anisotropy(ctx.ctm) > 1.02:
             self.keep_as_is(el, outer, "stroke under a non-uniform scale")
             return
-        written = style.get("paint-order")
-        order = _NORMAL_ORDER if written is None else paint_order(written)
+        order = facts.order
         markers_first = order[0] == "markers"
         if marks and markers_first:
             self._markers(el, geom, ctx, decls)

@@ -118,8 +118,15 @@ def test_cubics_placed_in_place_or_copied_are_the_same(monkeypatch):
     once = zigzag + '<path d="M 1 1 L 5 9"/>'
     head = '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 500 500">'
     bodies = (once, once + zigzag, once + f'<path d="{_ZIGZAG}" visibility="hidden"/>')
+    small = [parse_svg((head + body + "</svg>").encode()) for body in bodies]
+    assert in_place == [False, False, False]  # small copies are made without looking
+    in_place.clear()
+    monkeypatch.setattr(parse, "_SMALL_COPY", 0)
     scenes = [parse_svg((head + body + "</svg>").encode()) for body in bodies]
     assert in_place == [True, False, True]
+    for copied, placed in zip(small, scenes, strict=True):
+        for a, b in zip(copied.elements, placed.elements, strict=True):
+            assert a.cubics.tobytes() == b.cubics.tobytes()
     assert [len(s.elements) for s in scenes] == [2, 3, 2]
     for scene in scenes[1:]:
         for a, b in zip(scene.elements, scenes[0].elements, strict=False):

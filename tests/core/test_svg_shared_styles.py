@@ -1,9 +1,10 @@
 """What the SVG reader remembers to read many simple elements fast changes nothing it reads.
 
 Equal styles are shared and what is derived from them is remembered by identity
-(:mod:`lsys_core.svg.style`, :mod:`lsys_core.svg.declare`); a document without ``<use>`` is
-measured without the reference walk (:mod:`lsys_core.svg.uses`).  Each test compares against
-what the reader gives without the shortcut, or against values worked out by hand.
+(:mod:`lsys_core.svg.style`, :mod:`lsys_core.svg.declare`, :mod:`lsys_core.svg.facts`); a
+document without ``<use>`` is measured without the reference walk (:mod:`lsys_core.svg.uses`).
+Each test compares against what the reader gives with memos that forget at once, or against
+values worked out by hand.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import xml.etree.ElementTree as ET
 import pytest
 
 from lsys_core.errors import LimitError
-from lsys_core.svg import declare, parse_svg, style, uses
+from lsys_core.svg import declare, facts, parse_svg, style, uses
 from lsys_core.svg.css import StyleSheet
 from lsys_core.svg.style import Cascade
 from lsys_core.svg.tree import Tree
@@ -36,7 +37,8 @@ def _mixed_document() -> str:
         parts.append(
             f'<g {parent} transform="scale({1 + i % 2})">'
             f'<rect x="{i}" width="5" height="5" stroke="black"/>'
-            f'<rect x="{i}" y="9" width="5" height="5" stroke="black"/>'
+            f'<rect x="{i}" y="9" width="5" height="5" stroke="black" paint-order="stroke"/>'
+            f'<rect x="{i}" y="19" width="5" height="5" visibility="{("hidden", "visible")[i % 2]}"/>'
             f'<path d="M0 0 L{i + 1} 3" style="stroke:red;stroke-width:2em;fill:inherit !important"/>'
             f'<path class="c" d="M1 0 L{i + 1} 3" style="stroke:red;stroke-width:2em"/>'
             "</g>"
@@ -66,6 +68,7 @@ def test_small_memos_read_the_same(monkeypatch):
     assert len(fills) >= 12  # each group's own fill reached its children
     monkeypatch.setattr(style, "MEMO_SIZE", 2)
     monkeypatch.setattr(declare, "MEMO_SIZE", 2)
+    monkeypatch.setattr(facts, "MEMO_SIZE", 2)
     assert _scene_styles(text) == full
 
 
