@@ -36,6 +36,8 @@ __all__ = ["fit_paint", "match_instances"]
 _NUMERIC = ("opacity", "fill-opacity", "stroke-opacity", "stroke-width")
 #: Largest exact assignment problem solved per terminal; larger groups match greedily.
 _ASSIGN_LIMIT = 1500
+#: Instances nearest each element whose costs are measured before the whole matrix is.
+_NEAREST = 8
 #: Style lengths that a ``scaled`` terminal's instances scale with their turtle.
 _LENGTHS = ("stroke-width", "stroke-dasharray", "stroke-dashoffset")
 #: Relative agreement of stroke widths over scales for a terminal to count as ``scaled``
@@ -69,10 +71,13 @@ def match_instances(
         if mine.size != theirs.size:
             return None
         if mine.size <= _ASSIGN_LIMIT:
-            cost = np.abs(eb[mine][:, None] - b[theirs][None, :]) + scale * 1e-3 * np.abs(
-                ea[mine][:, None] - a[theirs][None, :]
-            )
-            rows, cols = _assignment(cost, scale)
+            found = _clear_nearest(eb[mine], ea[mine], b[theirs], a[theirs], scale)
+            if found is None:
+                cost = np.abs(eb[mine][:, None] - b[theirs][None, :]) + scale * 1e-3 * np.abs(
+                    ea[mine][:, None] - a[theirs][None, :]
+                )
+                found = _assignment(cost, scale)
+            rows, cols = found
             out[theirs[cols]] = mine[rows]
         else:
             out[theirs] = _greedy(eb[mine], b[theirs], mine)
@@ -98,6 +103,36 @@ def _assignment(cost: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]
     from scipy.optimize import linear_sum_assignment
 
     return linear_sum_assignment(cost)
+
+
+def _clear_nearest(
+    eb: np.ndarray, ea: np.ndarray, b: np.ndarray, a: np.ndarray, scale: float
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """What :func:`_assignment` finds without the whole cost matrix, when its first case holds.
+
+    The cost of a pair is at least the distance of its places, so the :data:`_NEAREST`
+    instances nearest every element (a k-d tree) hold the element's two cheapest ones
+    whenever the farthest of them is farther than the second cheapest.  When that holds for
+    every element and each has one clearly cheapest instance, a different one for each, that
+    is the only optimum (the costs are the dense matrix's own, to the bit); otherwise None.
+    The matrix of a 1,200-leaf grid took 30 ms of every weight change.
+    """
+    n = eb.size
+    if n <= 2 * _NEAREST:
+        return None
+    from scipy.spatial import cKDTree
+
+    dist, near = cKDTree(np.column_stack([b.real, b.imag])).query(
+        np.column_stack([eb.real, eb.imag]), k=_NEAREST
+    )
+    cost = np.abs(eb[:, None] - b[near]) + scale * 1e-3 * np.abs(ea[:, None] - a[near])
+    two = np.partition(cost, 1, axis=1)
+    cols = near[np.arange(n), np.argmin(cost, axis=1)]
+    clear = two[:, 1] > two[:, 0] + 1e-9 * scale
+    outside = dist[:, -1] > two[:, 1] + 1e-9 * scale  # every other instance costs more still
+    if clear.all() and outside.all() and np.unique(cols).size == n:
+        return np.arange(n), cols
+    return None
 
 
 def _greedy(target: np.ndarray, found: np.ndarray, ids: np.ndarray) -> np.ndarray:

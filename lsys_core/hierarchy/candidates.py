@@ -96,8 +96,14 @@ class Candidate:
         return len(self.groups)
 
     def nodes(self) -> np.ndarray:
-        """All live nodes the candidate explains."""
-        return np.concatenate(self.groups)
+        """All live nodes the candidate explains (read-only: made once, the choice asks often)."""
+        return self._nodes
+
+    @cached_property
+    def _nodes(self) -> np.ndarray:
+        out = np.concatenate(self.groups)
+        out.setflags(write=False)
+        return out
 
     def remapped(self, mapping: np.ndarray) -> Candidate:
         """Return the candidate with node indices renumbered by ``mapping`` (after another was applied)."""

@@ -17,7 +17,7 @@ groups of elements.  Each level:
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
@@ -31,6 +31,7 @@ from lsys_core.hierarchy.emit import const_t, const_t_many, emit
 from lsys_core.hierarchy.gain import Ledger
 from lsys_core.hierarchy.mdl import Precision
 from lsys_core.hierarchy.nodes import Nodes
+from lsys_core.hierarchy.reuse import Level, context_key
 from lsys_core.hierarchy.rings import find_rings, ring_rule, ring_shortens
 from lsys_core.hierarchy.select import Measure, Weights, choose, worthwhile
 from lsys_core.hierarchy.snap import SHARE
@@ -217,25 +218,29 @@ def build_hierarchy(
         report(progress, "rules", 1.0 - (len(nodes) - 1) / max(n0 - 1, 1))
         t0 = time.perf_counter()
         period = np.concatenate([term_period, np.zeros(len(table) - nt)])
-        ledger = Ledger(prec, nodes, table)
         key = _level_key(table, nodes, tol, neighbours, prec) if cache is not None else b""
         found = cache.get(key) if cache is not None else None
+        ledger: Ledger | None = None
         t1 = time.perf_counter()
         if found is None:
+            ledger = Ledger(prec, nodes, table)
             ps = pair_space(nodes.a, nodes.b, nodes.center, nodes.radius, k=neighbours)
             t1 = time.perf_counter()
-            found = find_candidates(ctx, nodes.sym, ps, nodes.radius, ledger)
+            found = Level(find_candidates(ctx, nodes.sym, ps, nodes.radius, ledger))
             if cache is not None:
-                cache.put(key, found)
-        cands = found
+                cache.put(key, found, found.nbytes)
         t2 = time.perf_counter()
         chosen: list[Candidate] = []
-        if cands and level < MAX_LEVELS:
-            starts = _starts(cands, nodes.first_members())
-            cands = [replace(c, start=st) for c, st in zip(cands, starts, strict=True)]
+        if found.cands and level < MAX_LEVELS:
+            context = context_key(nodes, table, period, limit, snap) if cache is not None else b""
+            view = found.view(
+                context,
+                partial(Ledger, prec, nodes, table) if ledger is None else partial(_same, ledger),
+                nodes.first_members,
+            )
             test = partial(
                 worthwhile,
-                ledger=ledger,
+                ledger=view.ledger,
                 nodes=nodes,
                 sizes=table.sizes,
                 period=period,
@@ -244,7 +249,15 @@ def build_hierarchy(
                 n_terminals=nt,
                 limit=limit,
             )
-            chosen = choose(cands, weights, len(nodes), test, ledger.ceiling)
+            chosen = choose(
+                view.cands,
+                weights,
+                len(nodes),
+                view.tested(test),
+                view.ceiling,
+                order=view.order(weights),
+                index=view.index,
+            )
         if chosen:
             level += 1
             nodes = _apply_all(table, book, chosen, nodes)
@@ -263,8 +276,9 @@ def build_hierarchy(
 
 
 def _level_key(table: SymbolTable, nodes: Nodes, tol: Tolerance, neighbours: int, prec: Precision) -> bytes:
-    """What a level's candidates depend on: nodes, symbols (sizes, families, kinds), bandwidths, precision."""
+    """What a level's candidates depend on: nodes, symbols (sizes, families, kinds, counters), bandwidths, precision."""
     terminal = np.arange(len(table)) < table.n_terminals
+    counters = np.array([-1 if s.m is None else s.m for s in table.infos], np.int64)
     arrays = [
         nodes.sym,
         nodes.a,
@@ -274,6 +288,7 @@ def _level_key(table: SymbolTable, nodes: Nodes, tol: Tolerance, neighbours: int
         table.sizes,
         table.families(),
         terminal,
+        counters,
     ]
     return LevelCache.key(arrays, (tol, neighbours, repr(prec)))
 
@@ -353,22 +368,8 @@ def _duplicates(table: SymbolTable, nodes: Nodes) -> list[Candidate]:
     ]
 
 
-def _starts(cands: list[Candidate], first: np.ndarray) -> list[tuple[float, float]]:
-    """Mean input order of the first and of the second elements of each candidate's applications.
-
-    One pass over all candidates' applications (a mean per candidate cost 4,224 numpy calls per
-    weight change on a 1,200-element scene: 40 ms); the orders are integers, so the sums are
-    exact and the means those of ``np.mean``.
-    """
-    counts = np.array([len(c.groups) for c in cands], np.int64)
-    total = int(counts.sum())
-    heads = np.fromiter((g[0] for c in cands for g in c.groups), np.int64, total)
-    seconds = np.fromiter((g[1] if g.size > 1 else g[0] for c in cands for g in c.groups), np.int64, total)
-    offsets = np.concatenate(([0], np.cumsum(counts)[:-1]))
-    order = np.asarray(first, np.float64)
-    head = np.add.reduceat(order[heads], offsets) / counts
-    second = np.add.reduceat(order[seconds], offsets) / counts
-    return list(zip(head.tolist(), second.tolist(), strict=True))
+def _same(ledger: Ledger) -> Ledger:
+    return ledger
 
 
 def _apply_all(table: SymbolTable, book: _Book, chosen: list[Candidate], nodes: Nodes) -> Nodes:

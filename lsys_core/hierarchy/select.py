@@ -20,7 +20,17 @@ from lsys_core.hierarchy.nodes import Nodes
 from lsys_core.hierarchy.snap import SHARE, plainer, snapped
 from lsys_core.settings import setting
 
-__all__ = ["WEAK_COVER", "Measure", "Weights", "choose", "importance_order", "scores", "worthwhile"]
+__all__ = [
+    "WEAK_COVER",
+    "Measure",
+    "Weights",
+    "choose",
+    "importance_order",
+    "importance_terms",
+    "node_index",
+    "scores",
+    "worthwhile",
+]
 
 #: ``measure(elements, a, b)``: how far input elements would be from their terminals drawn at poses ``a, b``.
 Measure = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
@@ -136,27 +146,42 @@ def _admitted(
     return replace(c, slack=tuple(float(v) for v in slack), starts=poses, gain=gain)
 
 
-def scores(cands: list[Candidate], w: Weights) -> np.ndarray:
-    """The importance ``w = wn·n + wh·h + wφ·φ + wl·l`` of every candidate (§5.4, eq. 5)."""
-    cov = max(c.covered for c in cands)
-    lmax = max(c.l for c in cands)
-    return np.array(
-        [w.wn * c.covered / cov + w.wh * min(c.h, 1.0) + w.wphi * c.phi + w.wl * (c.l / lmax) for c in cands]
-    )
+def importance_terms(cands: list[Candidate]) -> np.ndarray:
+    """The terms the importance order reads, one row per candidate: ``covered, h, φ, l, start``.
+
+    They do not depend on the weights: a level's rows are kept with its candidates
+    (:mod:`lsys_core.hierarchy.reuse`) and every weight change only combines them.
+    """
+    rows = [(c.covered, c.h, c.phi, c.l, c.start[0], c.start[1]) for c in cands]
+    return np.array(rows, np.float64).reshape(len(rows), 6)
 
 
-def importance_order(cands: list[Candidate], weights: Weights) -> tuple[np.ndarray, list[int]]:
+def scores(cands: list[Candidate], w: Weights, terms: np.ndarray | None = None) -> np.ndarray:
+    """The importance ``w = wn·n + wh·h + wφ·φ + wl·l`` of every candidate (§5.4, eq. 5).
+
+    ``terms`` (:func:`importance_terms` of ``cands``) saves reading them again; the sums are
+    taken in the same order as term by term, so the values are the same to the last bit.
+    """
+    t = importance_terms(cands) if terms is None else terms
+    covered, h, phi, l = t[:, 0], t[:, 1], t[:, 2], t[:, 3]
+    return w.wn * covered / covered.max() + w.wh * np.minimum(h, 1.0) + w.wphi * phi + w.wl * (l / l.max())
+
+
+def importance_order(
+    cands: list[Candidate], weights: Weights, terms: np.ndarray | None = None
+) -> tuple[np.ndarray, list[int]]:
     """Rounded importance of every candidate, and the candidates most important first.
 
-    Ties go to the candidate that covers more, then to the one that comes first in the drawing.
+    Ties go to the candidate that covers more, then to the one that comes first in the drawing
+    (then to the one found first).  ``terms`` as in :func:`scores`.
     """
-    score = np.round(scores(cands, weights), 9)
-    order = sorted(
-        range(len(cands)),
-        key=lambda i: (score[i], cands[i].covered, -cands[i].start[0], -cands[i].start[1]),
-        reverse=True,
-    )
-    return score, order
+    t = importance_terms(cands) if terms is None else terms
+    score = np.round(scores(cands, weights, t), 9)
+    if np.isfinite(score).all() and np.isfinite(t[:, 4:]).all():
+        # a stable sort on the keys negated: what ``sorted(..., reverse=True)`` gives
+        return score, np.lexsort((t[:, 5], t[:, 4], -t[:, 0], -score)).tolist()
+    key = [(score[i], t[i, 0], -t[i, 4], -t[i, 5]) for i in range(len(cands))]
+    return score, sorted(range(len(cands)), key=key.__getitem__, reverse=True)
 
 
 def choose(
@@ -165,6 +190,9 @@ def choose(
     n_nodes: int,
     worthwhile: Callable[[Candidate], Candidate | None],
     ceiling: Callable[[Candidate], float] | None = None,
+    *,
+    order: tuple[np.ndarray, list[int]] | None = None,
+    index: Callable[[], tuple[np.ndarray, np.ndarray]] | None = None,
 ) -> list[Candidate]:
     """The candidates to apply at this level, most important first (§5.4–§5.5).
 
@@ -180,19 +208,22 @@ def choose(
     one on some of its nodes that shortens it far more (:func:`_dominant`): importance orders
     repetitions of similar worth, but a branching of two pairs that saves 0.1 bit does not take
     the leaves of three rings that save 111.
+
+    ``order`` (:func:`importance_order` of ``cands`` and ``weights``) and ``index`` (giving
+    :func:`node_index` of ``cands``) save computing them again.
     """
-    score, order = importance_order(cands, weights)
-    index: tuple[np.ndarray, np.ndarray] | None = None
+    score, order_ = importance_order(cands, weights) if order is None else order
+    owners: tuple[np.ndarray, np.ndarray] | None = None
     taken = np.zeros(n_nodes, bool)
     out: list[Candidate] = []
     k = 0
-    while k < len(order):
-        # candidates of equal importance (consecutive in ``order``): the one that shortens the
+    while k < len(order_):
+        # candidates of equal importance (consecutive in ``order_``): the one that shortens the
         # description most goes first
         end = k + 1
-        while end < len(order) and score[order[end]] == score[order[k]]:
+        while end < len(order_) and score[order_[end]] == score[order_[k]]:
             end += 1
-        tied = order[k:end]
+        tied = order_[k:end]
         k = end
         found = []
         for i in tied:
@@ -203,9 +234,9 @@ def choose(
             if taken[nodes].any():
                 continue
             if ceiling is not None:
-                if index is None:
-                    index = _node_index(cands, n_nodes)
-                c = _dominant(c, cands, index, taken, worthwhile, ceiling)
+                if owners is None:
+                    owners = node_index(cands, n_nodes) if index is None else index()
+                c = _dominant(c, cands, owners, taken, worthwhile, ceiling)
                 nodes = c.nodes()
             taken[nodes] = True
             out.append(c)
@@ -221,7 +252,7 @@ DOMINANT = 4.0
 DOMINANT_BITS = 32.0
 
 
-def _node_index(cands: list[Candidate], n_nodes: int) -> tuple[np.ndarray, np.ndarray]:
+def node_index(cands: list[Candidate], n_nodes: int) -> tuple[np.ndarray, np.ndarray]:
     """The candidates on every node: ``owners[start[k]:start[k + 1]]`` are those on node ``k``."""
     nodes = [np.unique(c.nodes()) for c in cands]
     flat = np.concatenate(nodes) if nodes else np.zeros(0, int)

@@ -312,3 +312,30 @@ def test_matching_without_the_optimiser_is_the_optimisers_matching() -> None:
             assert rows.tolist() == want_rows.tolist() and cols.tolist() == want_cols.tolist()
     tie = np.zeros((3, 3))  # every matching is optimal: the optimiser's choice is kept
     assert [c.tolist() for c in _assignment(tie, 1.0)] == [c.tolist() for c in linear_sum_assignment(tie)]
+
+
+def test_matching_from_the_nearest_instances_is_the_whole_matrix_matching() -> None:
+    from lsys_core.derive.faithful import _assignment, _clear_nearest
+
+    rng = np.random.default_rng(5)
+    shortcuts = 0
+    for n in (20, 300):
+        for jitter in (0.0, 0.001, 0.05, 2.0):  # exact, near, neighbours' turns close, a muddle
+            points = rng.uniform(0, 100, n) + 1j * rng.uniform(0, 100, n)
+            turns = np.exp(1j * rng.uniform(0, 6.3, n))
+            if n == 300:
+                points[:50] = points[50:100]  # stacked copies told apart by their turns only
+            perm = rng.permutation(n)
+            moved = points[perm] + jitter * (rng.normal(size=n) + 1j * rng.normal(size=n))
+            moved_turns = turns[perm] * np.exp(1j * jitter * rng.normal(size=n))
+            scale = float(np.ptp(np.concatenate([points.real, points.imag])))
+            found = _clear_nearest(points, turns, moved, moved_turns, scale)
+            if found is None:
+                continue
+            shortcuts += 1
+            cost = np.abs(points[:, None] - moved[None, :]) + scale * 1e-3 * np.abs(
+                turns[:, None] - moved_turns[None, :]
+            )
+            want = _assignment(cost, scale)
+            assert [x.tolist() for x in found] == [x.tolist() for x in want]
+    assert shortcuts >= 4  # the shortcut is taken where the match is clear
