@@ -177,7 +177,9 @@ def build_hierarchy(
         If given, seconds spent are added under ``transforms``, ``clustering`` and ``rules``.
     cache
         If given, every level's candidates are looked up in it first and stored in it
-        (they do not depend on ``weights``: re-weighting reuses them).
+        (they do not depend on ``weights``: re-weighting reuses them), with what choosing
+        among them reads besides the weights (:mod:`.reuse`).  One cache serves one set of
+        input elements and one ``measure``.
     stretch_base, stretch
         Per terminal, the terminal it is a stretched copy of (-1: none) and the stretch
         (:mod:`lsys_core.instancing.stretch`): such a terminal is written as its base drawn with

@@ -30,6 +30,16 @@ def _same(r1, r2) -> None:
     assert r1.log == r2.log
 
 
+def _counted(calls: dict[str, int], name: str, fn):
+    """``fn``, counting its calls in ``calls[name]``."""
+
+    def wrapper(*args, **kwargs):
+        calls[name] += 1
+        return fn(*args, **kwargs)
+
+    return wrapper
+
+
 @pytest.mark.parametrize("name", ["facade", "flower-ring", "tiled-ornament"])
 def test_rules_from_analysis_equal_full_runs_for_every_weight(name: str) -> None:
     scene = load_svg(EXAMPLES / f"{name}.svg")
@@ -45,17 +55,10 @@ def test_reweighting_runs_neither_similarity_nor_first_level_clustering_again(mo
     rules_from_analysis(analysis)
     calls = {"similarity": 0, "levels": 0}
 
-    def counted(name, fn):
-        def wrapper(*args, **kwargs):
-            calls[name] += 1
-            return fn(*args, **kwargs)
-
-        return wrapper
-
     monkeypatch.setattr(
-        similarity_mod, "detect_similarity", counted("similarity", similarity_mod.detect_similarity)
+        similarity_mod, "detect_similarity", _counted(calls, "similarity", similarity_mod.detect_similarity)
     )
-    monkeypatch.setattr(rules_mod, "find_candidates", counted("levels", rules_mod.find_candidates))
+    monkeypatch.setattr(rules_mod, "find_candidates", _counted(calls, "levels", rules_mod.find_candidates))
     hits = analysis.levels.hits
     rules_from_analysis(analysis, Weights())
     assert calls == {"similarity": 0, "levels": 0}  # same weights: every level is known
@@ -109,15 +112,8 @@ def test_weights_met_before_test_no_candidate_again(monkeypatch) -> None:
     rules_from_analysis(analysis, WEIGHTS[0])
     calls = {"worthwhile": 0, "ceiling": 0}
 
-    def counted(name, fn):
-        def wrapper(*args, **kwargs):
-            calls[name] += 1
-            return fn(*args, **kwargs)
-
-        return wrapper
-
-    monkeypatch.setattr(rules_mod, "worthwhile", counted("worthwhile", rules_mod.worthwhile))
-    monkeypatch.setattr(gain_mod.Ledger, "ceiling", counted("ceiling", gain_mod.Ledger.ceiling))
+    monkeypatch.setattr(rules_mod, "worthwhile", _counted(calls, "worthwhile", rules_mod.worthwhile))
+    monkeypatch.setattr(gain_mod.Ledger, "ceiling", _counted(calls, "ceiling", gain_mod.Ledger.ceiling))
     again = rules_from_analysis(analysis, WEIGHTS[1])
     _same(again, first)
     assert calls == {"worthwhile": 0, "ceiling": 0}
