@@ -25,6 +25,7 @@ from lsys_core.hierarchy.gain import Ledger
 from lsys_core.hierarchy.nodes import Nodes
 from lsys_core.hierarchy.select import Weights, importance_order, importance_terms, node_index
 from lsys_core.hierarchy.symbols import SymbolTable
+from lsys_core.memo import IdentityMemo
 
 __all__ = ["Level", "LevelView", "context_key", "start_orders"]
 
@@ -85,8 +86,8 @@ class LevelView:
         starts = start_orders(cands, first) if cands else []
         self.cands = [replace(c, start=st) for c, st in zip(cands, starts, strict=True)]
         self.terms = importance_terms(self.cands)
-        self._tested: dict[int, tuple[Candidate, Candidate | None]] = {}
-        self._ceilings: dict[int, tuple[Candidate, float]] = {}
+        self._tested: IdentityMemo[Candidate, Candidate | None] = IdentityMemo()
+        self._ceilings: IdentityMemo[Candidate, float] = IdentityMemo()
         self._index: tuple[np.ndarray, np.ndarray] | None = None
 
     def order(self, weights: Weights) -> tuple[np.ndarray, list[int]]:
@@ -101,27 +102,14 @@ class LevelView:
 
     def ceiling(self, c: Candidate) -> float:
         """:meth:`~lsys_core.hierarchy.gain.Ledger.ceiling` of ``c``, remembered."""
-        found = self._ceilings.get(id(c))
-        if found is not None and found[0] is c:
-            return found[1]
-        bound = self.ledger.ceiling(c)
-        self._ceilings[id(c)] = (c, bound)
-        return bound
+        return self._ceilings.get(c, self.ledger.ceiling)
 
     def tested(
         self, test: Callable[[Candidate], Candidate | None]
     ) -> Callable[[Candidate], Candidate | None]:
         """``test`` (:func:`~lsys_core.hierarchy.select.worthwhile` in this context), remembering its outcomes."""
 
-        def remembered(c: Candidate) -> Candidate | None:
-            found = self._tested.get(id(c))
-            if found is not None and found[0] is c:
-                return found[1]
-            outcome = test(c)
-            self._tested[id(c)] = (c, outcome)
-            return outcome
-
-        return remembered
+        return lambda c: self._tested.get(c, test)
 
 
 class Level:

@@ -12,6 +12,7 @@ import functools
 from collections.abc import Callable
 
 from lsys_core.geometry.paths import ArrayPath
+from lsys_core.memo import IdentityMemo
 from lsys_core.svg.masking import EMPTY, Definitions
 from lsys_core.svg.paint import paint_declarations, parse_paint, scale_of, stroke_declarations, unit_value
 from lsys_core.svg.records import Ctx, box_of, paint_order
@@ -87,7 +88,7 @@ class DeclarationMemo:
 
     def __init__(self) -> None:
         self._memo: dict[tuple, dict[str, str]] = {}
-        self._styles: dict[int, tuple[dict[str, str], tuple | None]] = {}
+        self._styles: IdentityMemo[dict[str, str], tuple | None] = IdentityMemo(MEMO_SIZE)
         self._scale: tuple[tuple, float] | None = None
 
     def get(
@@ -110,12 +111,7 @@ class DeclarationMemo:
     def _key(self, style: dict[str, str], ctx: Ctx) -> tuple | None:
         if ctx.context is not None:
             return None
-        known = self._styles.get(id(style))
-        if known is None or known[0] is not style:
-            if len(self._styles) >= MEMO_SIZE:
-                self._styles.clear()
-            known = self._styles[id(style)] = (style, self._style_key(style))  # holds the style: no id reuse
-        items = known[1]
+        items = self._styles.get(style, self._style_key)
         if items is None:
             return None
         scale = self._scale

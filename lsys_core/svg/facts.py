@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+from lsys_core.memo import IdentityMemo
 from lsys_core.svg.records import paint_order
 from lsys_core.svg.shapes import capped_stroke
 from lsys_core.svg.style import DEFAULT_FONT_SIZE
@@ -56,15 +57,8 @@ class StyleFactsMemo:
     """
 
     def __init__(self) -> None:
-        self._memo: dict[int, tuple[dict[str, str], StyleFacts]] = {}
+        self._memo: IdentityMemo[dict[str, str], StyleFacts] = IdentityMemo(MEMO_SIZE)
 
     def get(self, style: dict[str, str]) -> StyleFacts:
         """Return :func:`style_facts` of ``style``."""
-        got = self._memo.get(id(style))
-        if got is not None and got[0] is style:
-            return got[1]
-        facts = style_facts(style)
-        if len(self._memo) >= MEMO_SIZE:
-            self._memo.clear()
-        self._memo[id(style)] = (style, facts)
-        return facts
+        return self._memo.get(style, style_facts)
