@@ -48,20 +48,27 @@ _M_MMAP_THRESHOLD = -3
 KEEP_FREED = 1 << 30
 
 
-def _one_malloc_arena() -> bool:
-    """Ask glibc for a single malloc arena (see the module docstring); False where that is not glibc."""
+def _glibc() -> ctypes.CDLL | None:
+    """The C library of this process if it is glibc, else None (musl has no arenas to tune)."""
     if not sys.platform.startswith("linux"):
-        return False
+        return None
     try:
         libc = ctypes.CDLL(None)
-        if not hasattr(libc, "gnu_get_libc_version"):
-            return False  # not glibc (musl has no arenas to tune)
-        return bool(libc.mallopt(_M_ARENA_MAX, 1))
-    except (OSError, AttributeError):
-        return False
+    except OSError:
+        return None
+    return libc if hasattr(libc, "gnu_get_libc_version") else None
 
 
-ONE_ARENA = _one_malloc_arena()
+_GLIBC = _glibc()
+
+
+def _mallopt(param: int, value: int) -> bool:
+    """glibc's ``mallopt(param, value)``; False where it refuses or the C library is not glibc."""
+    return _GLIBC is not None and bool(_GLIBC.mallopt(param, value))
+
+
+#: Whether glibc was asked for a single malloc arena (see the module docstring).
+ONE_ARENA = _mallopt(_M_ARENA_MAX, 1)
 
 
 def keep_freed_memory() -> bool:
@@ -77,10 +84,7 @@ def keep_freed_memory() -> bool:
     inference process lives on between runs, decides for its own process).
     Returns False where the C library is not glibc.
     """
-    if not ONE_ARENA:  # not glibc (or mallopt refused already)
-        return False
-    libc = ctypes.CDLL(None)
-    return bool(libc.mallopt(_M_MMAP_THRESHOLD, KEEP_FREED) and libc.mallopt(_M_TRIM_THRESHOLD, KEEP_FREED))
+    return _mallopt(_M_MMAP_THRESHOLD, KEEP_FREED) and _mallopt(_M_TRIM_THRESHOLD, KEEP_FREED)
 
 
 def available_cores() -> int:
