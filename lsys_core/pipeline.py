@@ -20,7 +20,7 @@ from lsys_core.errors import InferenceError
 from lsys_core.grammar.model import Grammar
 from lsys_core.hierarchy.cache import LevelCache
 from lsys_core.hierarchy.describe import flat_bits, grammar_bits
-from lsys_core.hierarchy.explain import explained_share
+from lsys_core.hierarchy.explain import explained_share, repeating_rules
 from lsys_core.hierarchy.mdl import Precision
 from lsys_core.hierarchy.pivots import estimate_pivots, recenter
 from lsys_core.hierarchy.postprocess import simplify
@@ -72,6 +72,10 @@ NOISE_FLOOR = 0.5
 #: The tolerance of :func:`symmetrize`, whose purpose is to move elements onto a regular pattern
 #: (share of the diagonal; the user's tolerance if larger).
 SYMMETRIZE_ERROR = 0.03
+#: :func:`infer` also tries this share of the tolerance when near-identical shapes that differ
+#: by more than it share a terminal that is placed one by one somewhere (scenes of at most
+#: :data:`LARGE_SCENE` elements), and keeps it when its rules explain more.
+TIGHTER = 0.25
 
 
 def _shape_similarity(inst: Instancing, cancel: CancelToken | None) -> np.ndarray:
@@ -358,6 +362,20 @@ def rules_from_analysis(
     )
 
 
+def _merged_placed_alone(result: InferenceResult, tight: float) -> bool:
+    """Whether a terminal the rules place one by one somewhere stands for shapes that differ by more than ``tight``."""
+    inst = result.instancing
+    if inst.deviation is None or not np.any(inst.deviation > tight):
+        return False
+    far = {inst.terminals[g].name for g in np.unique(inst.group[inst.deviation > tight])}
+    drawing = derive(result.grammar, limit=max(10 * inst.group.size, 1000))
+    repeats = repeating_rules(result.grammar)
+    by_rule = np.array([r.name in repeats for r in result.grammar.rules] + [False], bool)  # -1: the axiom
+    alone = np.unique(drawing.symbol[~by_rule[drawing.rule]])
+    bases = drawing.bases or tuple(range(len(drawing.terminals)))
+    return any(drawing.terminals[bases[int(k)]].name in far for k in alone)
+
+
 def infer(
     scene: Scene,
     settings: InferenceSettings = InferenceSettings(),
@@ -390,7 +408,11 @@ def infer(
     description length, :mod:`lsys_core.hierarchy.mdl`) and derive their elements within the
     tolerance.  If the rules found at the user's clustering bandwidth leave elements
     unexplained by any repetition, the clustering is relaxed (×3 … ×15) and the shortest
-    grammar (in bits) that stays within the tolerance is kept.
+    grammar (in bits) that stays within the tolerance is kept.  When the tolerance let shapes
+    that differ by more than :data:`TIGHTER` of it share a terminal and the rules leave elements
+    unexplained, the inference runs again at that tighter tolerance and keeps whichever
+    explains more of the drawing (:attr:`InferenceResult.tolerance` says which); only when such
+    a terminal is placed one by one somewhere (there the merge may have cost a repetition).
 
     Returns
     -------
@@ -399,6 +421,22 @@ def infer(
     t_all = time.perf_counter()
     analysis = analyse(scene, settings, symmetrizing=symmetrizing, cancel=cancel, progress=progress)
     result = rules_from_analysis(analysis, symmetrizing=symmetrizing, cancel=cancel, progress=progress)
+    tight = TIGHTER * analysis.precision.eps
+    if (
+        not symmetrizing
+        and result.explained < 1.0
+        and len(scene.elements) <= LARGE_SCENE
+        and tight > EXACT_PLACEMENT * analysis.precision.diagonal
+        and _merged_placed_alone(result, tight)
+    ):
+        # A looser tolerance should only buy structure.  When it lets shapes that differ share
+        # a terminal (a symmetric corner merged into asymmetric ones), the terminal's copies
+        # no longer repeat exactly what each kind repeats: keep the tighter description when
+        # its rules explain more of the drawing (it is also the more faithful one).
+        closer = analyse(scene, replace(settings, deviation=tight), cancel=cancel, progress=progress)
+        other = rules_from_analysis(closer, cancel=cancel, progress=progress)
+        if other.explained > result.explained:
+            result = other
     return replace(result, seconds=time.perf_counter() - t_all)
 
 
