@@ -62,6 +62,8 @@ RULE_BITS = 32.0
 LINEAR_SHARE = 0.25
 #: Axes rows are looked for along: the canvas's (charts and designers' grids are aligned to them).
 AXES = (1 + 0j, 1j)
+#: Stray levels a row may step over to find its second level (between later levels, any number).
+STRAYS = 2
 
 
 @dataclass(frozen=True)
@@ -157,32 +159,65 @@ def _level_runs(
 
     ``along`` is sorted; values within ``merge`` (default ``q``) of the previous one share a
     level.  Returns ``(indices into along, count per level, step)`` of every run of at least
-    :data:`MIN_COPIES` levels whose places fit ``start + i·step`` within ``q``.
+    :data:`MIN_COPIES` levels whose places fit ``start + i·step`` within ``q``, ``count``
+    indices per level in level order.  A run steps over stray values between its levels (a
+    legend's dot beside the rows of a chart), and a level holding strays besides its ``count``
+    values gives the run the values nearest its place.
     """
-    new_level = np.concatenate(([True], np.diff(along) > (q if merge is None else merge)))
-    starts = np.flatnonzero(new_level)
+    gap = q if merge is None else merge
+    starts = np.flatnonzero(np.concatenate(([True], np.diff(along) > gap)))
     counts = np.diff(np.append(starts, along.size))
     level = np.add.reduceat(along, starts) / counts
-    gaps = np.diff(level)
     runs = []
     i = 0
     while i + MIN_COPIES <= level.size:
-        j = i  # extend while the level counts and the gaps stay alike (linear time)
-        while j + 1 < level.size and counts[j + 1] == counts[i] and abs(gaps[j] - gaps[i]) <= q:
-            j += 1
-        span = level[i : j + 1] - level[i]
-        k = np.arange(span.size)
-        step = span[-1] / max(j - i, 1)
-        if np.max(np.abs(span - k * step)) > q:  # the gaps drift: keep what the first gap fits
-            step = float(gaps[i]) if i < gaps.size else 0.0
-            bad = np.flatnonzero(np.abs(span - k * step) > q)
-            j = i + (int(bad[0]) - 1 if bad.size else j - i)
-        if j - i + 1 >= MIN_COPIES and step > 2 * (q if merge is None else merge):
-            runs.append((np.arange(starts[i], starts[j] + counts[j]), int(counts[i]), float(step)))
-            i = j + 1
+        path, step = _walk(level, counts, i, q, gap)
+        span = level[path] - level[i]
+        if path.size >= 2 and np.max(np.abs(span - np.arange(path.size) * step)) > q:
+            step = float(span[1])  # the gaps drift: keep what the first gap fits
+            bad = np.flatnonzero(np.abs(span - np.arange(path.size) * step) > q)
+            path = path[: int(bad[0])] if bad.size else path
+        if path.size >= MIN_COPIES and step > 2 * gap:
+            k = int(counts[i])
+            at = [_nearest(along, starts[c], counts[c], level[i] + n * step, k) for n, c in enumerate(path)]
+            runs.append((np.concatenate(at), k, float(step)))
+            i = int(path[-1]) + 1
         else:
             i += 1
     return runs
+
+
+def _walk(level: np.ndarray, counts: np.ndarray, i: int, q: float, gap: float) -> tuple[np.ndarray, float]:
+    """Levels evenly spaced from level ``i`` holding at least its count, and their mean step.
+
+    The step is the gap to the next such level at most :data:`STRAYS` levels on; each next level
+    is the one nearest the place the step predicts, within ``q``; levels between are strays.
+    """
+    k = counts[i]
+    ahead = np.flatnonzero(counts[i + 1 : i + 2 + STRAYS] >= k)
+    if not ahead.size:
+        return np.array([i]), 0.0
+    path = [i, i + 1 + int(ahead[0])]
+    step = float(level[path[1]] - level[i])
+    if step <= 2 * gap:
+        return np.array(path), step
+    while True:
+        want = level[path[-1]] + step
+        c = int(np.searchsorted(level, want))
+        c = c - 1 if c == level.size or (c > 0 and want - level[c - 1] < level[c] - want) else c
+        if c <= path[-1] or abs(level[c] - want) > q or counts[c] < k:
+            break
+        path.append(c)
+        step = float(level[c] - level[i]) / (len(path) - 1)
+    return np.array(path), step
+
+
+def _nearest(along: np.ndarray, start: int, count: int, place: float, k: int) -> np.ndarray:
+    """Indices of the ``k`` values of the level ``along[start:start+count]`` nearest ``place``, in order."""
+    if count == k:
+        return np.arange(start, start + k)
+    near = np.argsort(np.abs(along[start : start + count] - place), kind="stable")[:k]
+    return start + np.sort(near)
 
 
 def _merge(along: np.ndarray) -> float:

@@ -69,6 +69,24 @@ def test_rows_of_dots_at_data_positions_are_one_rule() -> None:
     assert_scenes_close(s, drawing_scene(derive(g)))
 
 
+def test_rows_of_dots_step_over_a_legend_of_the_same_dots() -> None:
+    rng = np.random.default_rng(5)
+    # a dot plot as above, with two legend dots of the same shape among its rows: one between
+    # two rows, one two units above a row (it would merge with that row's dots)
+    x = 100 + rng.uniform(0, 60, (12, 2))
+    frames = [pose(x[i, j], 20 + 12 * i, 0, 2.5) for i in range(12) for j in range(2)]
+    legend = [pose(250, 20 + 12 * 3 + 5, 0, 2.5), pose(250, 20 + 12 * 7 - 2, 0, 2.5)]
+    s = scene(
+        place(CIRCLE, frames + legend, "fill:#4c78a8;stroke:none"),
+        place(LEAF, [pose(0, 0), pose(300, 200, 40)]),
+    )
+    g = infer(s).grammar
+    tables = _table_rules(g)
+    assert len(tables) == 1
+    assert _placed_by(g, tables[0]) == 24
+    assert_scenes_close(s, drawing_scene(derive(g)))
+
+
 def test_copies_at_random_places_make_no_table_rule() -> None:
     rng = np.random.default_rng(7)
     frames = [pose(*xy) for xy in rng.uniform(0, 1000, (300, 2))]
