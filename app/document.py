@@ -319,7 +319,8 @@ class Document(DocumentFiles, QObject):
         """Return the digest of the input scene (computed once per scene; None: no scene).
 
         Weight changes send it with the scene, so the worker finds its kept analysis without
-        digesting the scene again.
+        digesting the scene again.  A scene the worker loaded comes with the key its analysis is
+        kept under; others are digested here once.
         """
         if self.scene is None:
             return None
@@ -353,6 +354,10 @@ class Document(DocumentFiles, QObject):
 
     def _on_inferred(self, purpose: Purpose, out: InferOutcome) -> None:
         kind = purpose.kind
+        if out.scene is not None and out.scene_key is not None:
+            # the worker keeps the analysis of the scene it loaded under this key: later
+            # requests name it (the UI thread need not digest the scene)
+            self._scene_key = (out.scene, out.scene_key)
         if kind == "reload":
             self.scene, self.scene_path = out.scene, purpose.path
             self.sceneChanged.emit()

@@ -31,8 +31,8 @@ def counted(monkeypatch):
     return calls
 
 
-def _infer(scene, settings):
-    request = jobs.InferRequest(scene, settings)
+def _infer(scene, settings, key=None):
+    request = jobs.InferRequest(scene, settings, scene_key=key)
     return jobs.run_inference(request, CancelToken(), lambda stage, fraction: None)
 
 
@@ -78,3 +78,40 @@ def test_the_document_digests_its_scene_once(window, wait_idle):
     doc = window.doc
     key = doc.scene_key()
     assert key == jobs.scene_digest(doc.scene) and doc.scene_key() is key
+
+
+def test_a_scene_sent_back_through_a_pipe_finds_the_analysis_kept_of_it(counted):
+    """The worker returns a loaded scene through a pipe (its arrays come back writeable, the
+    reader's are read-only): the requester's key for it is the one the analysis is kept under."""
+    import pickle
+    from multiprocessing.reduction import ForkingPickler
+
+    settings = pipeline.InferenceSettings()
+    request = jobs.InferRequest(None, settings, svg_path=str(EXAMPLES / "flower-ring.svg"))
+    opened = jobs.run_inference(request, CancelToken(), lambda stage, fraction: None)
+    assert not opened.reused_analysis and opened.scene_key == jobs._KEPT[0][0]
+    received = pickle.loads(ForkingPickler.dumps(opened))  # as the editor gets it
+    assert received.scene.elements[0].cubics.flags.writeable  # not as the reader made it
+    assert jobs.scene_digest(received.scene) == opened.scene_key
+    again = _infer(received.scene, replace(settings, wh=0.5))  # its key digested here
+    assert again.reused_analysis and len(counted) == 1
+
+
+def test_the_first_weight_change_after_opening_reuses_the_worker_analysis(window, wait_idle, monkeypatch):
+    """Opened in the worker process, re-weighted: the scene is not digested on the UI thread and
+    the worker finds the analysis it made when the file was opened."""
+    import app.document as document
+
+    digests = []
+    monkeypatch.setattr(document, "scene_digest", lambda scene: digests.append(1) or jobs.scene_digest(scene))
+    outcomes = []
+    window.doc.inference.done.connect(lambda purpose, out: outcomes.append((purpose.kind, out)))
+    window.open_path(str(EXAMPLES / "flower-ring.svg"))
+    wait_idle(window)
+    assert window.doc.scene_key() == outcomes[-1][1].scene_key
+    spin = window.inference_panel.rows["wh"].spin
+    spin.setValue(0.5 if spin.value() != 0.5 else 0.75)
+    wait_idle(window)
+    kinds = [kind for kind, _out in outcomes]
+    assert kinds == ["open", "settings"]
+    assert outcomes[-1][1].reused_analysis and digests == []

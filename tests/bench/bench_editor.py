@@ -18,7 +18,8 @@ Reports, in milliseconds:
   frame of the new step on screen (target ≤ 16 ms), timed like the slider moves.
 * weight change → new rules shown, for 300 and 1,200 elements (target ≤ 300 ms at 1,200): from
   typing a new weight into the inference panel to the new rules in the text, the panels and a
-  full-quality frame on the canvas (inference in the editor's worker process).
+  full-quality frame on the canvas (inference in the editor's worker process).  The first
+  change after opening the file is printed apart (it once analysed the scene again).
 * the longest UI stall while new rules with 600 parameters are applied (target ≤ 50 ms), as the
   gap of a 1 ms timer, with the UI thread's own CPU time in that gap (the rest is waiting for a
   core: on a loaded machine the wall time overstates the stall).
@@ -295,7 +296,13 @@ def bench_reweight(app, workdir: Path, rows: int, cols: int, repeats: int) -> di
     n = len(win.doc.drawing)
     win.doc.undo_stack.setClean()
     win.close()
-    return {"elements": n, "median_ms": statistics.median(times), "max_ms": max(times), "changed": changed}
+    return {
+        "elements": n,
+        "first_ms": times[0],
+        "median_ms": statistics.median(times),
+        "max_ms": max(times),
+        "changed": changed,
+    }
 
 
 def many_params_grammar(rules: int, shift: int) -> str:
@@ -397,8 +404,9 @@ def main(argv=None) -> int:
             r = bench_reweight(app, work, rows, cols, 3 if args.quick else 6)
             out.setdefault("reweight", []).append(r)
             print(
-                f"weight change → rules shown, {r['elements']:,} elements: {r['median_ms']:.0f} ms median, "
-                f"{r['max_ms']:.0f} ms max (target ≤ 300 ms at 1,200; rules changed {r['changed']} times)",
+                f"weight change → rules shown, {r['elements']:,} elements: first {r['first_ms']:.0f} ms, "
+                f"{r['median_ms']:.0f} ms median, {r['max_ms']:.0f} ms max (target ≤ 300 ms at 1,200, "
+                f"the first included; rules changed {r['changed']} times)",
                 flush=True,
             )
         for r in [bench_apply_stall(app, work, 2 if args.quick else 4)] if "apply" in parts else []:
