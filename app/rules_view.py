@@ -11,6 +11,11 @@ Like the parameters panel, cards fold: only open cards have control rows, a page
 :data:`~app.params_panel.ROWS_PER_PAGE` at a time ("Show more" adds one: a start with 240
 controls built them all in 39 ms, and Qt took 77 ms more to lay them out), and cards and rows
 are reused from one grammar to the next.
+
+Cards are made lazily: new rules show the cards of the first :data:`CARD_PAGE` rules, and
+the next ones are made as the view is scrolled near its end (or asked for, or selected).  Every
+change of a shown card lays out all shown cards again: with a card for each of 120 rules, that
+layout took the UI thread 20–35 ms per event-loop turn while new rules were shown.
 """
 
 from __future__ import annotations
@@ -18,7 +23,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from typing import Any
 
-from PySide6.QtCore import Qt, Signal
+from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtGui import QImage, QPixmap
 from PySide6.QtWidgets import (
     QFrame,
@@ -39,8 +44,10 @@ __all__ = ["OPEN_CONTROLS", "RulesView", "thumbnail"]
 
 #: Cards open on a new grammar until about this many controls are shown.
 OPEN_CONTROLS = 30
-#: Cards configured per event-loop turn (:meth:`RulesView.card_steps`).
+#: Cards configured per event-loop turn (:meth:`RulesView.card_steps`, and as more are shown).
 CARDS_PER_STEP = 12
+#: Cards shown at first on new rules; more as the view is scrolled near its end.
+CARD_PAGE = 16
 THUMB = 36
 _SEP = "\x1f"
 
@@ -199,7 +206,7 @@ class _Card(QFrame):
 
 
 class RulesView(QWidget):
-    """The dock content: a card per rule.
+    """The dock content: a card per rule, made as they are scrolled to.
 
     Signals
     -------
@@ -218,16 +225,41 @@ class RulesView(QWidget):
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.cards: dict[str, Any] = {}
+        self._order: tuple = ()  # the cards of the rules, in order (the first ``_shown`` have widgets)
+        self._terminals: dict[str, Any] = {}
+        self._shown = 0
+        self._budget = 0  # controls still to open on cards made later
         self._widgets: list[_Card] = []
         self._shape: list[tuple[str, tuple[str, ...]]] = []
         self._selected: str | None = None
         self._scroll, self._content, self._column, self._empty = scroll_column(
             self, "Open an SVG or .lsys file to see its rules.", spacing=4
         )
+        self.more = QPushButton(self._content)
+        self.more.setFlat(True)
+        self.more.clicked.connect(lambda: self.show_cards(self._shown + CARD_PAGE))
+        self._column.insertWidget(0, self.more)
+        self.more.hide()
+        self._fill = QTimer(self)  # shows more cards, a step per turn, while the view's end is near
+        self._fill.setSingleShot(True)
+        self._fill.setInterval(0)
+        self._fill.timeout.connect(self._fill_step)
+        bar = self._scroll.verticalScrollBar()
+        bar.valueChanged.connect(self._near_end)
+        bar.rangeChanged.connect(self._near_end)
+
+    @property
+    def shown(self) -> int:
+        """How many rules have a card (the first ones; the others are made when scrolled to)."""
+        return self._shown
 
     def widget_of(self, owner: str) -> _Card | None:
-        """Return the card widget of rule ``owner`` (None if it has none)."""
-        return next((w for w in self._widgets if not w.isHidden() and w.card and w.card.owner == owner), None)
+        """Return the card widget of rule ``owner``, made now if not yet (None if it has none)."""
+        index = next((i for i, c in enumerate(self._order) if c.owner == owner), None)
+        if index is None or not self._shape:
+            return None
+        self.show_cards(index + 1)
+        return self._widgets[index]
 
     def control(self, owner: str, label: str) -> Any:
         """Return the current :class:`~lsys_core.grammar.semantics.Control` of a rule, or None."""
@@ -243,50 +275,91 @@ class RulesView(QWidget):
         """Show the cards of ``grammar`` a few at a time, yielding between them.
 
         The window runs the steps in separate event-loop turns: configuring 120 cards took
-        the UI thread 100–160 ms in one turn.  An interrupted run (a newer grammar) leaves the
-        view marked as changed, so the next run configures every card again.
+        the UI thread 100–160 ms in one turn.  Only the cards shown get widgets (the first
+        :data:`CARD_PAGE`, or as many as were shown of the same rules).  An interrupted run (a
+        newer grammar) leaves the view marked as changed, so the next run configures every
+        card again.
         """
         self.cards = {c.owner: c for c in cards}
+        self._order = tuple(cards)
         shape = [(c.owner, tuple(k.label for k in c.controls)) for c in cards]
-        shown = [w for w in self._widgets if not w.isHidden()]
         if shape == self._shape:
-            for i, (widget, card) in enumerate(zip(shown, cards, strict=True)):
+            for i, (widget, card) in enumerate(zip(self._widgets[: self._shown], cards, strict=False)):
                 widget.update_values(card)
                 if i % CARDS_PER_STEP == CARDS_PER_STEP - 1:
                     yield
             return
         self._shape = []
-        terminals = {t.name: t for t in grammar.terminals}
-        budget = OPEN_CONTROLS
-        for i, card in enumerate(cards):
-            if i == len(self._widgets):
-                widget = _Card(self)
-                self._column.insertWidget(i, widget)
-                self._widgets.append(widget)
-            widget = self._widgets[i]
-            open_ = budget > 0 and bool(card.controls)
-            widget.configure(card, open_, terminals)
-            widget.set_selected(card.owner == self._selected)
-            widget.show()
-            if open_:
-                budget -= min(len(card.controls), ROWS_PER_PAGE)
+        self._fill.stop()
+        self.more.hide()
+        self._terminals = {t.name: t for t in grammar.terminals}
+        self._budget = OPEN_CONTROLS
+        self._shown = 0
+        count = min(len(cards), CARD_PAGE)
+        for i in range(count):
+            self._make(i)
             if i % CARDS_PER_STEP == CARDS_PER_STEP - 1:
                 yield
-        for widget in self._widgets[len(cards) :]:
+        for widget in self._widgets[count:]:
             widget.hide()
         self._scroll.setVisible(bool(cards))
         self._empty.setVisible(not cards)
         self._shape = shape
+        self._show_more_button()
+
+    def show_cards(self, count: int) -> None:
+        """Make the cards of the first ``count`` rules (those not made yet) and show them."""
+        if not self._shape:
+            return  # new rules are being shown: their steps make the first cards
+        count = min(count, len(self._order))
+        while self._shown < count:
+            self._make(self._shown)
+        self._show_more_button()
+
+    def _make(self, i: int) -> None:
+        """Configure and show the card of rule ``i`` (the ``i``-th widget, made if needed)."""
+        card = self._order[i]
+        if i == len(self._widgets):
+            widget = _Card(self)
+            self._column.insertWidget(self._column.count() - 1, widget)  # before the stretch
+            self._widgets.append(widget)
+        widget = self._widgets[i]
+        open_ = self._budget > 0 and bool(card.controls)
+        widget.configure(card, open_, self._terminals)
+        widget.set_selected(card.owner == self._selected)
+        widget.show()
+        if open_:
+            self._budget -= min(len(card.controls), ROWS_PER_PAGE)
+        self._shown = i + 1
+
+    def _show_more_button(self) -> None:
+        rest = len(self._order) - self._shown
+        self._column.removeWidget(self.more)
+        self._column.insertWidget(self._shown, self.more)  # after the shown cards
+        self.more.setText(f"Show {min(rest, CARD_PAGE)} more of {rest} rules…")
+        self.more.setVisible(rest > 0)
+
+    def _near_end(self, *_args: Any) -> None:
+        """More cards when the view shows (nearly) its end, a step per event-loop turn."""
+        bar = self._scroll.verticalScrollBar()
+        if (
+            self._shape
+            and self._shown < len(self._order)
+            and bar.value() >= bar.maximum() - self._scroll.viewport().height() // 2
+        ):
+            self._fill.start()
+
+    def _fill_step(self) -> None:
+        self.show_cards(self._shown + CARDS_PER_STEP)  # the view's range changes: _near_end again
 
     def select(self, owner: str | None) -> None:
         """Frame the card of rule ``owner`` and scroll to it (None: no selection)."""
         self._selected = owner
-        for widget in self._widgets:
-            widget.set_selected(
-                widget.card is not None and widget.card.owner == owner and not widget.isHidden()
-            )
+        for widget in self._widgets[: self._shown]:
+            widget.set_selected(widget.card is not None and widget.card.owner == owner)
         widget = self.widget_of(owner) if owner else None
         if widget is not None:
+            self._content.layout().activate()  # a card made just now has its place
             self._scroll.ensureWidgetVisible(widget, 0, 8)
 
     def _on_row_edited(self, key: str, value: float) -> None:

@@ -161,3 +161,68 @@ def test_a_grammar_with_stretched_bars_shows_its_stretch_and_draws_them(open_rul
     assert "stretch change with m" in labels
     window.canvas.set_highlight_terminal(0)  # the stretched bars are instances of A too
     assert window.canvas._highlight is not None and window.canvas._highlight.all()
+
+
+def _many_rules(rules: int, shift: int = 0) -> str:
+    lines = ["lsys 1", 'terminal A "M 0 0 L 4 0 L 4 4 Z" style "fill:#789"']
+    lines.append("axiom: " + " ".join(f"[ f({i * 7 + shift}) +(90) P{i}(3) ]" for i in range(rules)))
+    for i in range(rules):
+        lines.append(f"P{i}(m): m > 0 -> A +({i % 7 + 1}) f({10 + i}) P{i}(m-1)")
+        lines.append(f"P{i}(m): m == 0 -> A")
+    return "\n".join(lines) + "\n"
+
+
+def _assert_card_shows(view, index: int) -> None:
+    card = view._order[index]
+    widget = view.widget_of(card.owner)
+    assert widget is view._widgets[index] and not widget.isHidden()
+    assert widget.card is card and widget.name.text() == ("Start (axiom)" if index == 0 else card.owner)
+    assert widget.title.text().endswith(card.summary.split(": ", 1)[-1])
+
+
+def test_cards_are_made_as_they_are_scrolled_to_and_show_their_rules(open_rules, qtbot):
+    from app.rules_view import CARD_PAGE
+
+    window = open_rules(_many_rules(80))
+    view = window.rules_view
+    total = len(view.cards)
+    assert total == 81
+    assert CARD_PAGE <= view.shown < total and len(view._widgets) < total  # not one per rule
+    assert not view.more.isHidden() and f"of {total - view.shown} rules" in view.more.text()
+    bar = view._scroll.verticalScrollBar()
+    for _ in range(total):  # scrolled to the end again and again: more cards each time
+        if view.shown == total:
+            break
+        before, end = view.shown, bar.maximum()
+        bar.setValue(end)
+        # more cards, laid out: the view reaches further
+        qtbot.waitUntil(lambda b=before, e=end: view.shown > b and bar.maximum() > e, timeout=10_000)
+    assert view.shown == total and view.more.isHidden()
+    for index in (0, total // 2, total - 1):
+        _assert_card_shows(view, index)
+
+
+def test_a_card_not_made_yet_is_made_when_selected_or_asked_for(open_rules, wait_idle):
+    window = open_rules(_many_rules(80))
+    view = window.rules_view
+    shown = view.shown
+    view.more.click()
+    assert view.shown > shown
+    window.select_rule("P70")
+    assert view.shown == 72 and view._widgets[71].card.owner == "P70"
+    assert view._widgets[71]._selected
+    _assert_card_shows(view, 71)
+
+
+def test_new_rules_show_a_page_of_cards_again_with_their_own_content(open_rules, wait_idle):
+    from app.rules_view import CARD_PAGE
+
+    window = open_rules(_many_rules(80))
+    view = window.rules_view
+    view.show_cards(60)
+    window.doc.edit_text(_many_rules(79, 3))
+    wait_idle(window)
+    assert CARD_PAGE <= view.shown < 60
+    assert all(w.isHidden() for w in view._widgets[view.shown :])
+    for index in range(view.shown):
+        _assert_card_shows(view, index)
