@@ -81,12 +81,11 @@ class MainWindow(WindowFiles, WindowEdits, QMainWindow):
 
         self.canvas = Canvas(self)
         self.canvas.overlay = self.handles = HandleOverlay(self.canvas)
-        self.message_bar = MessageBar(self)
+        self.message_bar = MessageBar(self.canvas)  # over the canvas: a message does not resize it
         central = QWidget(self)
         lay = QVBoxLayout(central)
         lay.setContentsMargins(0, 0, 0, 0)
         lay.setSpacing(0)
-        lay.addWidget(self.message_bar)
         lay.addWidget(self.canvas, 1)
         self.setCentralWidget(central)
 

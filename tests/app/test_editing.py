@@ -371,3 +371,20 @@ def test_replace_dialog_offers_input_shapes_and_svg_files(qtbot, corpus):
     assert not dialog.load_button.isEnabled()
     assert not dialog.add_shape_from("/nonexistent/shape.svg")
     assert "shape.svg" in dialog.error.text()
+
+
+def test_a_message_lies_over_the_canvas_without_resizing_it(window, helix_lsys, wait_idle, qtbot):
+    _open(window, helix_lsys, wait_idle)
+    canvas, bar = window.canvas, window.message_bar
+    size, frame = canvas.size(), canvas._frame
+    window.show_message("A note long enough to need a line of its own, at least on a narrow canvas.")
+    assert bar.isVisible() and bar.text().startswith("A note")
+    assert bar.parentWidget() is canvas and bar.geometry().top() == 0
+    assert bar.width() == canvas.width() and bar.height() >= bar.sizeHint().height() // 2
+    qtbot.wait(50)
+    assert canvas.size() == size and canvas._frame is frame and window.is_idle()  # nothing drawn again
+    window.resize(window.width() - 200, window.height())
+    qtbot.waitUntil(lambda: canvas.width() < size.width(), timeout=5_000)
+    assert bar.width() == canvas.width()  # it follows the canvas
+    bar.hide()
+    assert not bar.text()
