@@ -128,8 +128,8 @@ def infer_kept(
 def run_inference(request: InferRequest, cancel: CancelToken, progress: Progress) -> InferOutcome:
     """Load (if asked), infer or symmetrize, format and derive; runs on a worker."""
     scene = request.scene if request.scene is not None else core.load_svg(request.svg_path)
-    if request.load_only:
-        return InferOutcome(scene, None, "", None)
+    if request.load_only:  # its key digested here, not on the requester's UI thread
+        return InferOutcome(scene, None, "", None, scene_key=scene_digest(scene))
     key, reused = request.scene_key, False
     if request.symmetrize:
         result = core.symmetrize(scene, request.settings, cancel=cancel, progress=progress)

@@ -95,6 +95,10 @@ def test_a_scene_sent_back_through_a_pipe_finds_the_analysis_kept_of_it(counted)
     assert jobs.scene_digest(received.scene) == opened.scene_key
     again = _infer(received.scene, replace(settings, wh=0.5))  # its key digested here
     assert again.reused_analysis and len(counted) == 1
+    loaded = jobs.run_inference(
+        replace(request, load_only=True), CancelToken(), lambda stage, fraction: None
+    )  # a session restored: only loaded, the key comes with it
+    assert pickle.loads(ForkingPickler.dumps(loaded)).scene_key == opened.scene_key
 
 
 def test_the_first_weight_change_after_opening_reuses_the_worker_analysis(window, wait_idle, monkeypatch):
