@@ -144,10 +144,14 @@ class _FullPass:
         widths = [t.paints.width if t.paints.stroke is not None else None for t in self.terms]
         mats, symbols, sscales = self.mats, self.symbols, self.sscales
         matrix = skia.Matrix()
-        set_all, set_matrix, draw_path = matrix.setAll, self.canvas.setMatrix, self.canvas.drawPath
+        # The identity, then the instance's matrix: concat takes a Matrix at once, where
+        # setMatrix first tries its M44 overload (1 µs a call: 9 ms of 10,000 instances' 90).
+        canvas = self.canvas
+        set_all, reset, concat, draw_path = matrix.setAll, canvas.resetMatrix, canvas.concat, canvas.drawPath
         for k in positions:
             set_all(*mats[k])
-            set_matrix(matrix)
+            reset()
+            concat(matrix)
             t = symbols[k]
             ops = table[t]
             if widths[t] is not None and sscales[k] != 1.0:  # canvas-unit stroke: the local width
