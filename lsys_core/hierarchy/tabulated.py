@@ -177,11 +177,16 @@ def _level_runs(
             step = float(span[1])  # the gaps drift: keep what the first gap fits
             bad = np.flatnonzero(np.abs(span - np.arange(path.size) * step) > q)
             path = path[: int(bad[0])] if bad.size else path
-        if path.size >= MIN_COPIES and step > 2 * gap:
-            k = int(counts[i])
-            at = [_nearest(along, starts[c], counts[c], level[i] + n * step, k) for n, c in enumerate(path)]
+        k = int(counts[i])
+        at: list[np.ndarray] = []
+        for n, c in enumerate(path if step > 2 * gap else ()):
+            near = _nearest(along, starts[c], counts[c], level[i] + n * step, k)
+            if np.max(np.abs(along[near] - level[i] - n * step)) > q:
+                break  # a level spread wider than the tolerance (values chained within ``merge``)
+            at.append(near)
+        if len(at) >= MIN_COPIES:
             runs.append((np.concatenate(at), k, float(step)))
-            i = int(path[-1]) + 1
+            i = int(path[len(at) - 1]) + 1
         else:
             i += 1
     return runs

@@ -6,6 +6,7 @@ import numpy as np
 
 from lsys_core.derive.derivation import derive
 from lsys_core.grammar.model import Grammar, Turtle
+from lsys_core.hierarchy.tabulated import _level_runs
 from lsys_core.pipeline import infer
 from lsys_core.testing import assert_scenes_close, drawing_scene
 from tests.core.scenes import LEAF, place, pose, scene
@@ -111,3 +112,16 @@ def test_rows_of_turned_shapes_keep_their_pose() -> None:
     assert len(tables) == 1
     assert _placed_by(g, tables[0]) == 42
     assert_scenes_close(s, drawing_scene(derive(g)))
+
+
+def test_a_level_spread_wider_than_the_tolerance_ends_a_row() -> None:
+    # four levels of four values; the third's values are chained 1.1 apart (one level at a
+    # merge distance of 1.2) and one more: its four nearest its place reach 2.2 from it
+    spread = [17.8, 18.9, 20.0, 21.1, 22.2]
+    along = np.array([0.0] * 4 + [10.0] * 4 + spread + [30.0] * 4)
+    assert _level_runs(along, 1.2) == []
+    # the same with the stray one near the place: the row takes the four within the tolerance
+    along = np.array([0.0] * 4 + [10.0] * 4 + [19.0, 19.9, 20.0, 20.1, 21.0] + [30.0] * 4)
+    (at, k, step), *_ = _level_runs(along, 1.2)
+    assert (k, step, at.size) == (4, 10.0, 16)
+    assert np.max(np.abs(along[at].reshape(4, 4) - [[0], [10], [20], [30]])) <= 1.2
