@@ -13,6 +13,8 @@ all but one number:
   width and free heights), each drawn with its stretch, ``[ +(φ) f([o…]) +(-φ) ~([t…]) A ]``.
   In such a row, offsets and stretches that change by one amount per step (bars growing by
   16, their centres rising by 8) are written linear in ``m`` instead of as tables.
+  A row steps over stray copies of its shape among its levels (a chart's legend drawn with
+  the same dots), each of its copies within the tolerance of the row's place.
 
 The free number is written as a table value (``[v0, v1, …]``, entry ``m``), the rest as one
 rule.  These are looked for among the nodes that no exact repetition explained, just before the
