@@ -283,7 +283,7 @@ class MainWindow(WindowFiles, WindowEdits, QMainWindow):
         yield
         yield from self.rules_view.card_steps(grammar, cards)
         yield
-        self.structure_panel.set_content(grammar, cards, self.doc.drawing)
+        yield from self.structure_panel.content_steps(grammar, cards, self.doc.drawing)
         yield
         self.structure_panel.set_legend(legend(grammar, self.canvas.color_mode))
 

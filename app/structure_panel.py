@@ -14,6 +14,7 @@ The panel only displays and forwards: the window turns its signals into document
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -41,6 +42,9 @@ from .rules_view import thumbnail
 __all__ = ["StructurePanel"]
 
 ICON = 28
+#: Tree items made per event-loop turn while new rules are shown (the tree of 120 rules and
+#: their shapes, 241 items, took 5–9 ms in one turn, the longest of the panels' steps).
+ITEMS_PER_STEP = 80
 _ROLE = Qt.ItemDataRole.UserRole
 
 
@@ -143,6 +147,15 @@ class StructurePanel(QWidget):
         the content waits for :meth:`showEvent`: rebuilding a hidden tree costs as much as a
         shown one (30 ms of Python and as much again in Qt for 120 rules).
         """
+        for _ in self.content_steps(grammar, cards, drawing):
+            pass
+
+    def content_steps(self, grammar: Any, cards: tuple, drawing: Any) -> Iterator[None]:
+        """Do :meth:`set_content`, yielding between every :data:`ITEMS_PER_STEP` items of a new tree.
+
+        The window runs the steps in separate event-loop turns.  An interrupted run (newer
+        rules) leaves the tree marked as changed, so the next run builds it again.
+        """
         self.grammar, self._cards, self._drawing = grammar, cards, drawing
         if not self.isVisible():  # a tab behind another or a closed dock: fill it when it shows
             self._stale = True
@@ -156,8 +169,9 @@ class StructurePanel(QWidget):
             counts = self._count_texts(drawing)
             tree_key = tuple((c.owner, c.terminals, c.calls) for c in cards)
             if tree_key != self._tree_key:  # the structure changed: rebuild (else only the words)
+                self._tree_key = ()  # until the whole tree is there
+                yield from self._tree_steps(grammar, by_owner, counts)
                 self._tree_key = tree_key
-                self._fill_tree(grammar, by_owner, counts)
             else:
                 for name, items in self._items.items():
                     card = by_owner.get(name)
@@ -181,7 +195,8 @@ class StructurePanel(QWidget):
             self._updating = False
         self._enable_terminal_buttons()
 
-    def _fill_tree(self, grammar: Any, cards: dict[str, Any], counts: dict[str, str]) -> None:
+    def _tree_steps(self, grammar: Any, cards: dict[str, Any], counts: dict[str, str]) -> Iterator[None]:
+        """Build the tree of rules from the start down, yielding every :data:`ITEMS_PER_STEP` items."""
         self.tree.clear()
         self._items = {}
         terms = {t.name: t for t in grammar.terminals}
@@ -193,7 +208,9 @@ class StructurePanel(QWidget):
                 icons[t] = QIcon(thumbnail(terms[t], ICON - 8, dpr))
             return icons[t]
 
-        def add(parent: Any, name: str, path: tuple[str, ...]) -> None:
+        made = [0]
+
+        def add(parent: Any, name: str, path: tuple[str, ...]) -> Iterator[None]:
             card = cards.get(name)
             title = "Start (axiom)" if name == "axiom" else name
             summary = card.summary.split(": ", 1)[-1] if card else ""
@@ -207,11 +224,16 @@ class StructurePanel(QWidget):
                 leaf.setIcon(0, icon(t))
                 leaf.setData(0, _ROLE, None)
                 leaf.setData(1, _ROLE, t)
+            made[0] += 1 + len(card.terminals)
+            if made[0] >= ITEMS_PER_STEP:
+                made[0] = 0
+                yield
             for child in card.calls:
                 if child not in path:  # a rule never contains itself (recursion is its repetition)
-                    add(item, child, (*path, child))
+                    yield from add(item, child, (*path, child))
 
-        add(self.tree, "axiom", ("axiom",))
+        yield from add(self.tree, "axiom", ("axiom",))
+        yield
         self.tree.expandToDepth(2)
         self._fit_columns()
 

@@ -131,3 +131,18 @@ def open_rules(window, tmp_path, wait_idle):
         return window
 
     return open_
+
+
+@pytest.fixture
+def many_rules():
+    """Return ``many_rules(n, shift)``: .lsys text whose start places ``n`` rows, each a rule of its own."""
+
+    def text(rules: int, shift: int = 0) -> str:
+        lines = ["lsys 1", 'terminal A "M 0 0 L 4 0 L 4 4 Z" style "fill:#789"']
+        lines.append("axiom: " + " ".join(f"[ f({i * 7 + shift}) +(90) P{i}(3) ]" for i in range(rules)))
+        for i in range(rules):
+            lines.append(f"P{i}(m): m > 0 -> A +({i % 7 + 1}) f({10 + i}) P{i}(m-1)")
+            lines.append(f"P{i}(m): m == 0 -> A")
+        return "\n".join(lines) + "\n"
+
+    return text

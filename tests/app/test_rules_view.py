@@ -163,15 +163,6 @@ def test_a_grammar_with_stretched_bars_shows_its_stretch_and_draws_them(open_rul
     assert window.canvas._highlight is not None and window.canvas._highlight.all()
 
 
-def _many_rules(rules: int, shift: int = 0) -> str:
-    lines = ["lsys 1", 'terminal A "M 0 0 L 4 0 L 4 4 Z" style "fill:#789"']
-    lines.append("axiom: " + " ".join(f"[ f({i * 7 + shift}) +(90) P{i}(3) ]" for i in range(rules)))
-    for i in range(rules):
-        lines.append(f"P{i}(m): m > 0 -> A +({i % 7 + 1}) f({10 + i}) P{i}(m-1)")
-        lines.append(f"P{i}(m): m == 0 -> A")
-    return "\n".join(lines) + "\n"
-
-
 def _assert_card_shows(view, index: int) -> None:
     card = view._order[index]
     widget = view.widget_of(card.owner)
@@ -180,10 +171,10 @@ def _assert_card_shows(view, index: int) -> None:
     assert widget.title.text().endswith(card.summary.split(": ", 1)[-1])
 
 
-def test_cards_are_made_as_they_are_scrolled_to_and_show_their_rules(open_rules, qtbot):
+def test_cards_are_made_as_they_are_scrolled_to_and_show_their_rules(open_rules, many_rules, qtbot):
     from app.rules_view import CARD_PAGE
 
-    window = open_rules(_many_rules(80))
+    window = open_rules(many_rules(80))
     view = window.rules_view
     total = len(view.cards)
     assert total == 81
@@ -202,8 +193,8 @@ def test_cards_are_made_as_they_are_scrolled_to_and_show_their_rules(open_rules,
         _assert_card_shows(view, index)
 
 
-def test_a_card_not_made_yet_is_made_when_selected_or_asked_for(open_rules, wait_idle):
-    window = open_rules(_many_rules(80))
+def test_a_card_not_made_yet_is_made_when_selected_or_asked_for(open_rules, many_rules):
+    window = open_rules(many_rules(80))
     view = window.rules_view
     shown = view.shown
     view.more.click()
@@ -214,13 +205,13 @@ def test_a_card_not_made_yet_is_made_when_selected_or_asked_for(open_rules, wait
     _assert_card_shows(view, 71)
 
 
-def test_new_rules_show_a_page_of_cards_again_with_their_own_content(open_rules, wait_idle):
+def test_new_rules_show_a_page_of_cards_again_with_their_own_content(open_rules, many_rules, wait_idle):
     from app.rules_view import CARD_PAGE
 
-    window = open_rules(_many_rules(80))
+    window = open_rules(many_rules(80))
     view = window.rules_view
     view.show_cards(60)
-    window.doc.edit_text(_many_rules(79, 3))
+    window.doc.edit_text(many_rules(79, 3))
     wait_idle(window)
     assert CARD_PAGE <= view.shown < 60
     assert all(w.isHidden() for w in view._widgets[view.shown :])

@@ -111,3 +111,27 @@ def test_a_hidden_panel_catches_up_when_it_shows(facade, wait_idle):
     facade.structure_dock.show()
     assert "Q2" in panel._items and "P2" not in panel._items
     assert panel.tree.topLevelItem(0).text(2) == "72"
+
+
+def test_a_new_tree_is_built_a_few_items_per_turn_and_an_interrupted_one_again(open_rules, many_rules):
+    from app.structure_panel import ITEMS_PER_STEP
+
+    window = open_rules(many_rules(80))
+    panel = window.structure_panel
+    assert panel.isVisible()
+    grammar, cards, drawing = window.doc.grammar, panel._cards, window.doc.drawing
+    top = panel.tree.topLevelItem(0)
+    assert top.childCount() == 80 and set(panel._items) == {c.owner for c in cards}
+    panel._tree_key = ()  # as if the rules had a new structure
+    steps = panel.content_steps(grammar, cards, drawing)
+    next(steps)  # a part of the tree, in a turn of its own
+    assert 0 < panel.tree.topLevelItem(0).childCount() < 80
+    steps.close()  # newer rules came
+    assert panel._tree_key == () and not panel._updating
+    turns = sum(1 for _ in panel.content_steps(grammar, cards, drawing))
+    assert turns >= 2 * 80 // ITEMS_PER_STEP  # 80 rules and their shapes, in several turns
+    top = panel.tree.topLevelItem(0)
+    assert top.text(0) == "Start (axiom)" and top.childCount() == 80
+    assert sorted(top.child(i).text(0) for i in range(80)) == sorted(f"P{i}" for i in range(80))
+    assert all(top.child(i).child(0).text(0) == "A" for i in range(80))
+    assert panel._tree_key and set(panel._items) == {c.owner for c in cards}
