@@ -74,8 +74,10 @@ NOISE_FLOOR = 0.5
 SYMMETRIZE_ERROR = 0.03
 #: :func:`infer` also tries this share of the tolerance when near-identical shapes that differ
 #: by more than it share a terminal that is placed one by one somewhere (scenes of at most
-#: :data:`LARGE_SCENE` elements), and keeps it when its rules explain more.
+#: :data:`LARGE_SCENE` elements), and keeps it when its rules explain more elements, at least
+#: :data:`MIN_EXPLAINED` more for every production they add.
 TIGHTER = 0.25
+MIN_EXPLAINED = 2
 
 
 def _shape_similarity(inst: Instancing, cancel: CancelToken | None) -> np.ndarray:
@@ -409,10 +411,11 @@ def infer(
     tolerance.  If the rules found at the user's clustering bandwidth leave elements
     unexplained by any repetition, the clustering is relaxed (×3 … ×15) and the shortest
     grammar (in bits) that stays within the tolerance is kept.  When the tolerance let shapes
-    that differ by more than :data:`TIGHTER` of it share a terminal and the rules leave elements
-    unexplained, the inference runs again at that tighter tolerance and keeps whichever
-    explains more of the drawing (:attr:`InferenceResult.tolerance` says which); only when such
-    a terminal is placed one by one somewhere (there the merge may have cost a repetition).
+    that differ by more than :data:`TIGHTER` of it share a terminal that the rules place one
+    by one somewhere (there the merge may have cost a repetition), and the rules explain some
+    but not all of the drawing, the inference runs again at that tighter tolerance and keeps
+    it when it explains more elements, two more for every production it adds
+    (:attr:`InferenceResult.tolerance` says which tolerance the result is written at).
 
     Returns
     -------
@@ -424,7 +427,7 @@ def infer(
     tight = TIGHTER * analysis.precision.eps
     if (
         not symmetrizing
-        and result.explained < 1.0
+        and 0.0 < result.explained < 1.0  # cost: distinct shapes (nothing repeats) are not inferred twice
         and len(scene.elements) <= LARGE_SCENE
         and tight > EXACT_PLACEMENT * analysis.precision.diagonal
         and _merged_placed_alone(result, tight)
@@ -435,7 +438,12 @@ def infer(
         # its rules explain more of the drawing (it is also the more faithful one).
         closer = analyse(scene, replace(settings, deviation=tight), cancel=cancel, progress=progress)
         other = rules_from_analysis(closer, cancel=cancel, progress=progress)
-        if other.explained > result.explained:
+        # every production it adds must explain two more elements (a repetition places two at
+        # least): at a finer precision, chance coincidences among many elements (a chart's
+        # data) pay for pair rules of their own that explain next to nothing more
+        more = (other.explained - result.explained) * len(scene.elements)
+        added = other.grammar.production_count - result.grammar.production_count
+        if more > 0.5 and more >= MIN_EXPLAINED * added:
             result = other
     return replace(result, seconds=time.perf_counter() - t_all)
 

@@ -38,6 +38,7 @@ from lsys_core.hierarchy.snap import SHARE
 from lsys_core.hierarchy.spaces import pair_space
 from lsys_core.hierarchy.symbols import SymbolTable
 from lsys_core.hierarchy.tabulated import find_tabulated, shortens, tabulated_rule
+from lsys_core.hierarchy.twins import find_twins, twins_rule, twins_shorten
 
 __all__ = ["Hierarchy", "Tolerance", "Weights", "build_hierarchy"]
 
@@ -314,7 +315,7 @@ def _axiom(table: SymbolTable, book: _Book, nodes: Nodes) -> tuple[Module, ...]:
 def _tabulate(
     table: SymbolTable, book: _Book, nodes: Nodes, period: np.ndarray, prec: Precision
 ) -> tuple[Nodes, int]:
-    """Code the partly regular repetitions left (:mod:`.tabulated`, :mod:`.rings`) that shorten the description."""
+    """Code the partly regular repetitions left (:mod:`.tabulated`, :mod:`.rings`, :mod:`.twins`) that shorten the description."""
     groups: list[np.ndarray] = []
     syms: list[int] = []
     starts: list[tuple[complex, complex]] = []
@@ -339,6 +340,18 @@ def _tabulate(
             groups.append(ring.nodes)
             syms.append(table.symbol(name, ring.steps - 1))
             starts.append((ring.frame, ring.center))
+    left[np.concatenate(groups) if groups else np.zeros(0, int)] = False
+    for s in np.unique(nodes.sym[left]):
+        live = np.flatnonzero(nodes.sym == s)
+        for tw in find_twins(table, nodes, period, np.flatnonzero(left & (nodes.sym == s)), prec):
+            if not twins_shorten(prec, table, tw, twins_rule(table, tw, nodes, "T"), nodes, live):
+                continue
+            name = table.new_name("P")
+            book.add(twins_rule(table, tw, nodes, name), f"{name}: two copies in one pose")
+            live = live[(live != tw.first) & (live != tw.second)]
+            groups.append(np.array([tw.first, tw.second]))
+            syms.append(table.symbol(name, 1))
+            starts.append((complex(nodes.a[tw.first]), complex(nodes.b[tw.first])))
     if not groups:
         return nodes, 0
     nodes, _ = nodes.merge(groups, syms, starts=tuple(starts))
