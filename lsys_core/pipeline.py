@@ -73,11 +73,14 @@ NOISE_FLOOR = 0.5
 #: (share of the diagonal; the user's tolerance if larger).
 SYMMETRIZE_ERROR = 0.03
 #: :func:`infer` also tries this share of the tolerance when near-identical shapes that differ
-#: by more than it share a terminal that is placed one by one somewhere (scenes of at most
-#: :data:`LARGE_SCENE` elements), and keeps it when its rules explain more elements, at least
-#: :data:`MIN_EXPLAINED` more for every production they add.
+#: by more than it share a terminal that is placed one by one somewhere, and keeps it when its
+#: rules explain more elements, at least :data:`MIN_EXPLAINED` more for every production they
+#: add.  Only scenes of at most
+#: :data:`TIGHTER_SCENE` elements (icons, emoji: where a few merged shapes decide the
+#: structure) are inferred twice: a chart of 228 elements took 14 s, with the try 42 s.
 TIGHTER = 0.25
 MIN_EXPLAINED = 2
+TIGHTER_SCENE = 64
 
 
 def _shape_similarity(inst: Instancing, cancel: CancelToken | None) -> np.ndarray:
@@ -413,9 +416,10 @@ def infer(
     grammar (in bits) that stays within the tolerance is kept.  When the tolerance let shapes
     that differ by more than :data:`TIGHTER` of it share a terminal that the rules place one
     by one somewhere (there the merge may have cost a repetition), and the rules explain some
-    but not all of the drawing, the inference runs again at that tighter tolerance and keeps
-    it when it explains more elements, two more for every production it adds
-    (:attr:`InferenceResult.tolerance` says which tolerance the result is written at).
+    but not all of the drawing (scenes of at most :data:`TIGHTER_SCENE` elements), the
+    inference runs again at that tighter tolerance and keeps it when it explains more
+    elements, two more for every production it adds (:attr:`InferenceResult.tolerance` says
+    which tolerance the result is written at).
 
     Returns
     -------
@@ -428,7 +432,7 @@ def infer(
     if (
         not symmetrizing
         and 0.0 < result.explained < 1.0  # cost: distinct shapes (nothing repeats) are not inferred twice
-        and len(scene.elements) <= LARGE_SCENE
+        and len(scene.elements) <= TIGHTER_SCENE
         and tight > EXACT_PLACEMENT * analysis.precision.diagonal
         and _merged_placed_alone(result, tight)
     ):
