@@ -8,8 +8,6 @@ pairs in the (d, s) subspace, then the differences of consecutive pairs' turns.
 
 from __future__ import annotations
 
-import itertools
-
 import numpy as np
 
 from lsys_core import parallel
@@ -25,8 +23,11 @@ __all__ = ["linear_candidates"]
 
 #: Step clusters (Δα, Δβ) examined per (d, s) cluster, largest first: smaller ones cannot win.
 _STEP_CLUSTERS = 12
-#: Consecutive pairs from which the chains of the step clusters are solved on several threads.
+#: Consecutive pairs from which the chains of the step clusters are solved in several runs.
 _SPLIT = 200_000
+#: Consecutive pairs solved in one run at most (unless one step cluster has more): a run's
+#: arrays take about 100 bytes per pair, and two runs at a time held 0.9 GiB at 100,000 elements.
+_BATCH = 500_000
 
 
 def linear_candidates(
@@ -100,19 +101,26 @@ def linear_candidates(
 
 
 def _batches(sizes: list[int], workers: int) -> list[tuple[int, int]]:
-    """Split problems of these sizes into ≤ ``workers`` runs of about equal total size, in order.
+    """Split problems of these sizes into runs, in order, each of ≤ a worker's share and ≤ :data:`_BATCH` pairs.
 
     The problems are independent (:func:`_linear_chains` solves each on its own keys), so the
     runs can be solved on separate threads and their candidates concatenated in order: the
-    result does not depend on the number of workers.  Small inputs stay in one run.
+    result does not depend on the number of workers or runs.  Runs are at most
+    :data:`_BATCH` pairs (a larger problem is a run of its own), so memory stays bounded
+    whatever the scene's size; small inputs stay in one run.
     """
     total = sum(sizes)
-    if workers <= 1 or total < _SPLIT or len(sizes) < 2:
+    if total < _SPLIT or len(sizes) < 2:
         return [(0, len(sizes))]
-    cum = np.cumsum(sizes)
-    cuts = np.searchsorted(cum, total * np.arange(1, workers) / workers)
-    bounds = sorted({0, len(sizes), *(int(c) + 1 for c in cuts if 0 <= c < len(sizes) - 1)})
-    return list(itertools.pairwise(bounds))
+    cap = min(_BATCH, -(-total // max(workers, 1)))
+    runs, lo, acc = [], 0, 0
+    for i, size in enumerate(sizes):
+        if acc and acc + size > cap:
+            runs.append((lo, i))
+            lo, acc = i, 0
+        acc += size
+    runs.append((lo, len(sizes)))
+    return runs
 
 
 def _promising(
@@ -214,7 +222,7 @@ def _candidate(sym, ps, prox, chains_e, node_chains, n_pairs, n_nodes, dA, dB) -
     si = int(sym[ps.src[edges[0]]])
     return LinearCandidate(
         space=(si, si),
-        groups=Groups(node_chains.nodes % n_nodes, node_chains.offsets).arrays(),
+        groups=Groups(node_chains.nodes % n_nodes, node_chains.offsets),
         h=float(np.mean(prox[edges])),
         phi=1.0,
         l=float(steps),

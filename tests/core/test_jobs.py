@@ -118,14 +118,18 @@ def test_step_clusters_solved_in_batches_give_the_same_rules(restore_jobs, monke
 
 
 def test_batches_cover_every_problem_once_in_order() -> None:
-    from lsys_core.hierarchy.linear import _batches
+    from lsys_core.hierarchy.linear import _BATCH, _batches
 
     assert _batches([5, 5], 1) == [(0, 2)]
-    for sizes in ([300_000] * 5, [1, 900_000, 1, 1], [400_000, 1]):
-        for workers in (2, 3, 8):
+    for sizes in ([300_000] * 5, [1, 900_000, 1, 1], [400_000, 1], [700_000] * 9, [3_000_000, 10, 10]):
+        for workers in (1, 2, 3, 8):
             runs = _batches(sizes, workers)
-            assert runs[0][0] == 0 and runs[-1][1] == len(sizes) and len(runs) <= workers
+            assert runs[0][0] == 0 and runs[-1][1] == len(sizes)
             assert all(a < b for a, b in runs) and all(x[1] == y[0] for x, y in itertools.pairwise(runs))
+            # no run holds more than the workers' share of the pairs, nor more than a bounded
+            # number (memory), unless it is a single problem
+            cap = min(-(-sum(sizes) // workers), _BATCH)
+            assert all(sum(sizes[a:b]) <= cap or b - a == 1 for a, b in runs)
 
 
 def test_mean_shift_binned_in_blocks_is_the_same(monkeypatch) -> None:
