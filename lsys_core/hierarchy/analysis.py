@@ -113,10 +113,10 @@ def find_candidates(
         cand: Candidate
         if si == sj and lengths.max() >= 2:
             cand = SeqCandidate(
-                space=(si, sj), groups=chain_list.arrays(), h=h, phi=phi, l=float(np.mean(lengths)), A=A, B=B
+                space=(si, sj), groups=chain_list, h=h, phi=phi, l=float(np.mean(lengths)), A=A, B=B
             )
         else:
-            pairs = chain_list.head(2).arrays()
+            pairs = chain_list.head(2)
             cand = PairCandidate(space=(si, sj), groups=pairs, h=h, phi=phi, l=1.0, A=A, B=B)
             if si != sj:
                 pending.append((len(out), cluster))

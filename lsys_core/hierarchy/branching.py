@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from lsys_core.hierarchy.candidates import BranchCandidate, ConstantCluster, mean_rel
-from lsys_core.hierarchy.flat import isin
+from lsys_core.hierarchy.flat import Groups, isin
 from lsys_core.hierarchy.spaces import PairSpace
 
 __all__ = ["branch_candidates"]
@@ -65,7 +65,7 @@ def _trees(ps, space, one: ConstantCluster, two: ConstantCluster, prox, n_nodes)
         return None
     return BranchCandidate(
         space=space,
-        groups=tuple(nodes for _, nodes in trees),
+        groups=Groups.of(nodes for _, nodes in trees),
         h=float(max(np.mean(prox[used1]), np.mean(prox[used2]))),
         phi=1.0,
         l=float(np.mean([d for d, _ in trees])) * 2.0,

@@ -15,6 +15,7 @@ from typing import Protocol
 
 import numpy as np
 
+from lsys_core.hierarchy.flat import Groups, as_groups
 from lsys_core.hierarchy.spaces import PairSpace
 
 __all__ = [
@@ -57,8 +58,9 @@ class Candidate:
     ----------
     space : tuple of int
         The pair of symbols ``(first, second)`` whose transformation space it came from.
-    groups : tuple of ndarray of int
-        The live nodes of every application, its first node first.
+    groups : Groups
+        The live nodes of every application, its first node first (any sequence of integer
+        sequences is taken and held flat: a level of 100,000 nodes has millions of groups).
     h, phi, l : float
         Proximity, similarity and (relative) sequence length of the importance.
     start : tuple of float
@@ -76,7 +78,7 @@ class Candidate:
     """
 
     space: tuple[int, int]
-    groups: tuple[np.ndarray, ...]
+    groups: Groups
     h: float
     phi: float
     l: float
@@ -85,10 +87,13 @@ class Candidate:
     starts: tuple[tuple[complex, complex], ...] = ()
     gain: float = 0.0
 
-    @cached_property
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "groups", as_groups(self.groups))
+
+    @property
     def covered(self) -> int:
-        """Number of live nodes the candidate explains (counted once: scoring asks often)."""
-        return sum(map(len, self.groups))
+        """Number of live nodes the candidate explains."""
+        return int(self.groups.nodes.size)
 
     @property
     def repeats(self) -> int:
@@ -101,13 +106,13 @@ class Candidate:
 
     @cached_property
     def _nodes(self) -> np.ndarray:
-        out = np.concatenate(self.groups)
+        out = self.groups.nodes.view()
         out.setflags(write=False)
         return out
 
     def remapped(self, mapping: np.ndarray) -> Candidate:
         """Return the candidate with node indices renumbered by ``mapping`` (after another was applied)."""
-        return replace(self, groups=tuple(np.asarray(mapping)[g] for g in self.groups))
+        return replace(self, groups=Groups(np.asarray(mapping)[self.groups.nodes], self.groups.offsets))
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)

@@ -33,6 +33,7 @@ from lsys_core.hierarchy.candidates import (
     PairCandidate,
     SeqCandidate,
 )
+from lsys_core.hierarchy.flat import Groups
 from lsys_core.hierarchy.symbols import SymbolTable
 
 __all__ = [
@@ -66,7 +67,7 @@ class Emitted:
 
     rule: Rule
     log: str
-    groups: tuple[np.ndarray, ...]
+    groups: Groups
     syms: tuple[int, ...]
 
 
@@ -182,7 +183,7 @@ def counters(c: Candidate) -> tuple[int | None, ...]:
         return tuple(None for _ in c.groups)
     if isinstance(c, BranchCandidate):
         return c.depths
-    return tuple(int(g.size) - 1 for g in c.groups)
+    return tuple((c.groups.lengths - 1).tolist())
 
 
 _PREFIX = {PairCandidate: "X", SeqCandidate: "P", LinearCandidate: "P", BranchCandidate: "R"}
@@ -199,7 +200,7 @@ def _log(table: SymbolTable, c: Candidate, name: str) -> str:
         )
     if isinstance(c, BranchCandidate):
         return f"{name}: {len(c.groups)} branching structures, depths {sorted(set(c.depths))}"
-    return f"{name}: {len(c.groups)} sequences of {first}, lengths {sorted({int(g.size) for g in c.groups})}"
+    return f"{name}: {len(c.groups)} sequences of {first}, lengths {sorted(set(c.groups.lengths.tolist()))}"
 
 
 def emit(table: SymbolTable, c: Candidate) -> Emitted:

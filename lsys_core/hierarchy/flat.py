@@ -18,6 +18,7 @@ import numpy as np
 
 __all__ = [
     "Groups",
+    "as_groups",
     "follow_links",
     "greedy_disjoint",
     "greedy_links",
@@ -25,6 +26,11 @@ __all__ = [
     "isin",
     "sorted_unique",
 ]
+
+
+def as_groups(groups: Groups | Iterable[Iterable[int]]) -> Groups:
+    """``groups`` as :class:`Groups` (made with :meth:`Groups.of` unless it is one already)."""
+    return groups if isinstance(groups, Groups) else Groups.of(groups)
 
 
 def sorted_unique(x: np.ndarray) -> np.ndarray:
@@ -95,10 +101,9 @@ class Groups:
         flat = self.nodes.tolist()
         return [flat[lo:hi] for lo, hi in itertools.pairwise(self.offsets.tolist())]
 
-    def arrays(self) -> tuple[np.ndarray, ...]:
-        """Every group as its own array (views into :attr:`nodes`)."""
-        nodes = self.nodes
-        return tuple(nodes[lo:hi] for lo, hi in itertools.pairwise(self.offsets.tolist()))
+    def positions(self) -> np.ndarray:
+        """Position of every entry of :attr:`nodes` within its chain (0 for the first node)."""
+        return np.arange(self.nodes.size) - np.repeat(self.offsets[:-1], self.lengths)
 
     @property
     def lengths(self) -> np.ndarray:

@@ -10,6 +10,8 @@ puts every node within the tolerance of where it was drawn.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from lsys_core.geometry.transforms import rel_from_t4
@@ -23,7 +25,7 @@ from lsys_core.hierarchy.candidates import (
 )
 from lsys_core.hierarchy.describe import rule_bits, structured_bits, symbol_bits
 from lsys_core.hierarchy.emit import counters, rule_cases
-from lsys_core.hierarchy.flat import sorted_unique
+from lsys_core.hierarchy.flat import Groups, as_groups, sorted_unique
 from lsys_core.hierarchy.mdl import (
     KIND_BITS,
     Precision,
@@ -91,7 +93,7 @@ class Ledger:
         #: the keys of every family, increasing (what ``key_family == f`` selects)
         self.family_keys = [by_family[cuts[f] : cuts[f + 1]] for f in range(n_fam)]
         self._tables: dict[int, np.ndarray] = {}
-        self._last: tuple[tuple[np.ndarray, ...], tuple[float, float, np.ndarray, np.ndarray]] | None = None
+        self._last: tuple[Groups, tuple[float, float, np.ndarray, np.ndarray]] | None = None
         self.pose = np.array([self._key_pose(f, self.stacked[self.family_keys[f]]) for f in range(n_fam)])
 
     def _key_pose(self, f: int, stacks: np.ndarray) -> float:
@@ -208,7 +210,7 @@ class Ledger:
             before = self._family_bits(f, n, float(self.counts[f]))
             counts = float(self.counts[f] - self.node_counts[nodes[taken]].sum())
             saved += before - self._family_bits(f, n - k, counts, u, self._key_pose(f, left[mine]))
-        first = np.array([int(g[0]) for g in c.groups])
+        first = c.groups.firsts
         _, stacks = np.unique(self.cell[first], return_counts=True)
         new = placement_set_bits(self.prec, len(c.groups), occupied=stacks.size, token=self.token)
         out = (saved, float(new), first, stacks)
@@ -230,11 +232,11 @@ class Ledger:
         return rule_bits(self.prec, self.token, Rule("_", True, rule_cases(self.table, c, "_")))
 
 
-def group_reach(nodes: Nodes, groups: tuple[np.ndarray, ...]) -> np.ndarray:
+def group_reach(nodes: Nodes, groups: Groups | Sequence[np.ndarray]) -> np.ndarray:
     """How far every group's geometry reaches from its first node's origin (the lever of its heading)."""
-    flat = np.concatenate(groups)
-    owner = np.repeat(np.arange(len(groups)), [g.size for g in groups])
-    origin = nodes.b[np.array([int(g[0]) for g in groups])]
+    groups = as_groups(groups)
+    flat, owner = groups.nodes, groups.owner()
+    origin = nodes.b[groups.firsts]
     reach = np.zeros(len(groups))
     np.maximum.at(reach, owner, np.abs(nodes.center[flat] - origin[owner]) + nodes.radius[flat])
     return reach
@@ -291,9 +293,9 @@ def _chain_poses(nodes: Nodes, groups, A: complex, B: complex, lever: np.ndarray
     node's scale (only its turn and place are fitted): a rule does not start at a scale of
     1.00002 to absorb rounding.
     """
-    idx = np.concatenate(groups)
-    owner = np.repeat(np.arange(len(groups)), [g.size for g in groups])
-    k = np.concatenate([np.arange(g.size) for g in groups]).astype(float)
+    groups = as_groups(groups)
+    idx, owner = groups.nodes, groups.owner()
+    k = groups.positions().astype(float)
     u = A**k
     v = B * (k if abs(A - 1) < 1e-12 else (u - 1.0) / (A - 1.0))
     a, b, r2 = nodes.a[idx], nodes.b[idx], lever**2
@@ -323,7 +325,7 @@ def _chain_poses(nodes: Nodes, groups, A: complex, B: complex, lever: np.ndarray
 
 
 def _linear_poses(nodes: Nodes, c: LinearCandidate):
-    g = np.array([grp for grp in c.groups])  # all of one length: steps + 1
+    g = c.groups.nodes.reshape(len(c.groups), -1)  # all of one length: steps + 1
     a = nodes.a[g[:, 0]].copy()
     b = nodes.b[g[:, 0]].copy()
     pa, pb = [a.copy()], [b.copy()]
@@ -384,7 +386,7 @@ def placement_error(
     """
     starts = None
     if isinstance(c, (SeqCandidate, PairCandidate)):
-        lever = sizes[nodes.sym[np.concatenate(c.groups)]]
+        lever = sizes[nodes.sym[c.groups.nodes]]
         idx, pa, pb, starts = _chain_poses(nodes, c.groups, c.A, c.B, lever, own_scale)
     elif isinstance(c, LinearCandidate):
         idx, pa, pb = _linear_poses(nodes, c)

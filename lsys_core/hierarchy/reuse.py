@@ -43,9 +43,12 @@ def start_orders(cands: list[Candidate], first: np.ndarray) -> list[tuple[float,
     exact and the means those of ``np.mean``.
     """
     counts = np.array([len(c.groups) for c in cands], np.int64)
-    total = int(counts.sum())
-    heads = np.fromiter((g[0] for c in cands for g in c.groups), np.int64, total)
-    seconds = np.fromiter((g[1] if g.size > 1 else g[0] for c in cands for g in c.groups), np.int64, total)
+    heads = np.concatenate([c.groups.firsts for c in cands]) if cands else np.zeros(0, np.int64)
+    seconds = (
+        np.concatenate([c.groups.nodes[c.groups.offsets[:-1] + (c.groups.lengths > 1)] for c in cands])
+        if cands
+        else np.zeros(0, np.int64)
+    )
     offsets = np.concatenate(([0], np.cumsum(counts)[:-1]))
     order = np.asarray(first, np.float64)
     head = np.add.reduceat(order[heads], offsets) / counts
@@ -123,11 +126,10 @@ class Level:
 
     def __init__(self, cands: list[Candidate]) -> None:
         self.cands = cands
-        groups = sum(len(c.groups) for c in cands)
-        data = sum(g.nbytes for c in cands for g in c.groups)
+        data = sum(c.groups.nodes.nbytes + c.groups.offsets.nbytes for c in cands)
         #: bytes held, with as much again for a view's copies of the candidates and their outcomes
         #: (a 164-element flag's 195 levels: 0.63 MiB each measured, 0.66 estimated)
-        self.nbytes = 2 * (len(cands) * _OBJECT_BYTES + groups * _ARRAY_BYTES + data)
+        self.nbytes = 2 * (len(cands) * (_OBJECT_BYTES + 2 * _ARRAY_BYTES) + data)
         self._views: OrderedDict[bytes, LevelView] = OrderedDict()
 
     def view(

@@ -28,6 +28,7 @@ from lsys_core.hierarchy.analysis import find_candidates
 from lsys_core.hierarchy.cache import LevelCache
 from lsys_core.hierarchy.candidates import Candidate, SeqCandidate
 from lsys_core.hierarchy.emit import const_t, const_t_many, emit
+from lsys_core.hierarchy.flat import Groups
 from lsys_core.hierarchy.gain import Ledger
 from lsys_core.hierarchy.mdl import Precision
 from lsys_core.hierarchy.nodes import Nodes
@@ -378,7 +379,7 @@ def _duplicates(table: SymbolTable, nodes: Nodes) -> list[Candidate]:
         members = np.flatnonzero(inv == g)
         stacks.setdefault(int(sym[members[0]]), []).append(members)
     return [
-        SeqCandidate(space=(s, s), groups=tuple(groups), h=1.0, phi=1.0, l=1.0, A=1 + 0j, B=0j)
+        SeqCandidate(space=(s, s), groups=Groups.of(groups), h=1.0, phi=1.0, l=1.0, A=1 + 0j, B=0j)
         for s, groups in stacks.items()
     ]
 

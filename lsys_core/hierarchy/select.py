@@ -130,7 +130,7 @@ def _admitted(
         return None
     left, starts = fit(0.0)
     if starts is not None and not (left < 0.0).any() and np.isfinite(limit):
-        own = np.abs(nodes.a[[int(g[0]) for g in c.groups]])
+        own = np.abs(nodes.a[c.groups.firsts])
         off = np.abs(np.abs(starts[0]) - own) / np.maximum(own, 1e-300)
         snap = SHARE * limit / max(float(group_reach(nodes, c.groups).max()), 1e-12)
         if ((off > 0.0) & (off <= snap)).any():
@@ -139,7 +139,7 @@ def _admitted(
                 left, starts = plain, plain_starts
     if (left < 0.0).any():
         return None
-    owner = np.repeat(np.arange(len(c.groups)), [g.size for g in c.groups])
+    owner = c.groups.owner()
     slack = np.full(len(c.groups), np.inf)
     np.minimum.at(slack, owner, left)
     poses = () if starts is None else tuple(zip(starts[0].tolist(), starts[1].tolist(), strict=True))

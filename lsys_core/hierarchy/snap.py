@@ -50,7 +50,7 @@ def _snap_transform(
 
 def snapped(c: Candidate, nodes: Nodes, eps: float, share: float = SHARE) -> Candidate:
     """Return ``c`` with its numbers rounded within ``share`` of the tolerance ``eps`` (see the module docstring)."""
-    steps = max(max(int(g.size) for g in c.groups) - 1, 1)
+    steps = max(int(c.groups.lengths.max()) - 1, 1)
     if isinstance(c, BranchCandidate):
         steps = max(c.depths) + 1
     budget = share * eps / steps

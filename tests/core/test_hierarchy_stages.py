@@ -18,6 +18,7 @@ from lsys_core.hierarchy.candidates import (
 from lsys_core.hierarchy.chains import chains, edge_chains, follow, successor_pairs
 from lsys_core.hierarchy.clustering import group_indices
 from lsys_core.hierarchy.emit import const_t, emit, nice
+from lsys_core.hierarchy.flat import Groups
 from lsys_core.hierarchy.nodes import Nodes
 from lsys_core.hierarchy.rules import Tolerance, _Context
 from lsys_core.hierarchy.spaces import pair_space
@@ -184,3 +185,16 @@ def test_symbol_table_names_avoid_terminal_names() -> None:
     assert table.new_name("Z") == "Z1"
     assert table.new_name("P") == "P2"
     assert table.phi(0, 0) == 1.0 and table.phi(0, 1) == 0.0
+
+
+def test_candidate_holds_its_groups_flat_and_renumbers_them() -> None:
+    cand = SeqCandidate(
+        space=(0, 0), groups=(np.array([4, 1, 2]), np.array([0, 3])), h=1, phi=1, l=1.5, A=1 + 0j, B=2 + 0j
+    )
+    assert isinstance(cand.groups, Groups)
+    assert cand.groups.nodes.tolist() == [4, 1, 2, 0, 3] and cand.groups.offsets.tolist() == [0, 3, 5]
+    assert cand.covered == 5 and cand.repeats == 3 and cand.nodes().tolist() == [4, 1, 2, 0, 3]
+    assert not cand.nodes().flags.writeable
+    moved = cand.remapped(np.array([10, 11, 12, 13, 14]))
+    assert [g.tolist() for g in moved.groups] == [[14, 11, 12], [10, 13]]
+    assert [g.tolist() for g in cand.groups] == [[4, 1, 2], [0, 3]]  # the original is untouched
