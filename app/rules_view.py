@@ -23,7 +23,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from typing import Any
 
-from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Signal
 from PySide6.QtGui import QImage, QPixmap
 from PySide6.QtWidgets import (
     QFrame,
@@ -232,6 +232,7 @@ class RulesView(QWidget):
         self._widgets: list[_Card] = []
         self._shape: list[tuple[str, tuple[str, ...]]] = []
         self._selected: str | None = None
+        self._reveal: str | None = None  # a selected rule whose card is being made
         self._scroll, self._content, self._column, self._empty = scroll_column(
             self, "Open an SVG or .lsys file to see its rules.", spacing=4
         )
@@ -255,7 +256,7 @@ class RulesView(QWidget):
 
     def widget_of(self, owner: str) -> _Card | None:
         """Return the card widget of rule ``owner``, made now if not yet (None if it has none)."""
-        index = next((i for i, c in enumerate(self._order) if c.owner == owner), None)
+        index = self._index(owner)
         if index is None or not self._shape:
             return None
         self.show_cards(index + 1)
@@ -306,6 +307,8 @@ class RulesView(QWidget):
         self._empty.setVisible(not cards)
         self._shape = shape
         self._show_more_button()
+        if self._reveal:  # a rule selected while the cards were made
+            self._fill.start()
 
     def show_cards(self, count: int) -> None:
         """Make the cards of the first ``count`` rules (those not made yet) and show them."""
@@ -350,17 +353,55 @@ class RulesView(QWidget):
             self._fill.start()
 
     def _fill_step(self) -> None:
-        self.show_cards(self._shown + CARDS_PER_STEP)  # the view's range changes: _near_end again
+        if not self._reveal:
+            self.show_cards(self._shown + CARDS_PER_STEP)  # the view's range changes: _near_end again
+            return
+        reveal = self._index(self._reveal)
+        if reveal is None or not self._shape:  # the rule has gone, or new rules are being shown
+            self._reveal = None if reveal is None else self._reveal
+            return
+        self.show_cards(min(self._shown + CARDS_PER_STEP, reveal + 1))
+        if self._shown > reveal:
+            self._reveal = None
+            self._scroll_to(self._widgets[reveal])
+        else:
+            self._fill.start()
+
+    def _index(self, owner: str | None) -> int | None:
+        return next((i for i, c in enumerate(self._order) if c.owner == owner), None)
 
     def select(self, owner: str | None) -> None:
-        """Frame the card of rule ``owner`` and scroll to it (None: no selection)."""
+        """Frame the card of rule ``owner`` and scroll to it (None: no selection).
+
+        A card not made yet is made with those before it, a step per event-loop turn (a click
+        on the canvas may select the last of 120 rules), and scrolled to when it is there.
+        """
         self._selected = owner
+        self._reveal = None
         for widget in self._widgets[: self._shown]:
             widget.set_selected(widget.card is not None and widget.card.owner == owner)
-        widget = self.widget_of(owner) if owner else None
-        if widget is not None:
-            self._content.layout().activate()  # a card made just now has its place
-            self._scroll.ensureWidgetVisible(widget, 0, 8)
+        index = self._index(owner) if owner else None
+        if index is None or not self._shape:
+            return
+        if index < self._shown:
+            self._scroll_to(self._widgets[index])
+        else:
+            self._reveal = owner
+            self._fill.start()
+
+    def _scroll_to(self, widget: _Card) -> None:
+        """Scroll to a card now, and again in the next turn: cards made just now may still move
+        when they are laid out (their titles wrap), and the view grows with them."""
+        self._content.layout().activate()
+        QCoreApplication.sendPostedEvents(None, QEvent.Type.LayoutRequest)
+        self._scroll.ensureWidgetVisible(widget, 0, 8)
+        card = widget.card
+
+        def again() -> None:  # unless another rule was selected, or new rules came meanwhile
+            if card is not None and widget.card is card and card.owner == self._selected:
+                self._scroll.ensureWidgetVisible(widget, 0, 8)
+
+        QTimer.singleShot(0, self, again)
 
     def _on_row_edited(self, key: str, value: float) -> None:
         owner, label = key.split(_SEP, 1)

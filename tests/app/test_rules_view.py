@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 
 import pytest
-from PySide6.QtCore import QPointF, Qt
+from PySide6.QtCore import QPoint, QPointF, Qt
 
 GRID = """lsys 1
 terminal A "M 0 0 L 8 0 L 8 8 Z" style "fill:#789"
@@ -193,15 +193,20 @@ def test_cards_are_made_as_they_are_scrolled_to_and_show_their_rules(open_rules,
         _assert_card_shows(view, index)
 
 
-def test_a_card_not_made_yet_is_made_when_selected_or_asked_for(open_rules, many_rules):
+def test_a_card_not_made_yet_is_made_when_selected_or_asked_for(open_rules, many_rules, qtbot):
     window = open_rules(many_rules(80))
     view = window.rules_view
     shown = view.shown
     view.more.click()
     assert view.shown > shown
-    window.select_rule("P70")
-    assert view.shown == 72 and view._widgets[71].card.owner == "P70"
-    assert view._widgets[71]._selected
+    window.select_rule("P70")  # made a step per turn, then scrolled to
+    qtbot.waitUntil(lambda: view._reveal is None and view.shown >= 72, timeout=10_000)
+    qtbot.wait(20)  # scrolled to again once the new cards are laid out
+    widget = view._widgets[71]
+    assert widget.card.owner == "P70" and widget._selected
+    viewport = view._scroll.viewport()
+    top = widget.mapTo(viewport, QPoint(0, 0)).y()
+    assert 0 <= top < viewport.height()  # in sight
     _assert_card_shows(view, 71)
 
 
