@@ -72,10 +72,13 @@ def analyse(scene: Any, settings: Any, *, previous=None, cancel=None, progress=N
 
 
 def rules_from_analysis(analysis: Any, *, cancel=None, progress=None) -> Any:
-    """Rules for the analysis' settings (``lsys_core.pipeline.rules_from_analysis``)."""
+    """Rules for the analysis' settings, as ``infer`` would end (``lsys_core.pipeline.rules_from_analysis``
+    then ``tighter_if_better``)."""
     from lsys_core.pipeline import rules_from_analysis as _rules
+    from lsys_core.pipeline import tighter_if_better
 
-    return _rules(analysis, cancel=cancel, progress=progress)
+    result = _rules(analysis, cancel=cancel, progress=progress)
+    return tighter_if_better(analysis, result, cancel=cancel, progress=progress)
 
 
 def symmetrize(scene: Any, settings: Any, *, cancel=None, progress=None) -> Any:

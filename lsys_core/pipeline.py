@@ -53,6 +53,7 @@ __all__ = [
     "infer",
     "rules_from_analysis",
     "symmetrize",
+    "tighter_if_better",
 ]
 
 #: Default tolerance: the derived drawing may deviate from the input by this share of its diagonal.
@@ -381,6 +382,42 @@ def _merged_placed_alone(result: InferenceResult, tight: float) -> bool:
     return any(drawing.terminals[bases[int(k)]].name in far for k in alone)
 
 
+def tighter_if_better(
+    analysis: Analysis,
+    result: InferenceResult,
+    *,
+    cancel: CancelToken | None = None,
+    progress: Progress | None = None,
+) -> InferenceResult:
+    """``result``, or the rules at :data:`TIGHTER` of the tolerance when they explain more.
+
+    A looser tolerance should only buy structure.  When it lets shapes that differ share a
+    terminal (a symmetric corner merged into asymmetric ones) that the rules then place one by
+    one somewhere, the terminal's copies no longer repeat exactly what each kind repeats: the
+    scene (of at most :data:`TIGHTER_SCENE` elements) is inferred again at the tighter
+    tolerance, and that result is kept when its rules explain more elements, at least
+    :data:`MIN_EXPLAINED` more for every production they add (it is also the more faithful
+    one).  :func:`infer` and the editor's worker both end with it, so both give the same rules.
+    """
+    scene, settings = analysis.scene, analysis.settings
+    tight = TIGHTER * analysis.precision.eps
+    if not (
+        0.0 < result.explained < 1.0  # cost: distinct shapes (nothing repeats) are not inferred twice
+        and len(scene.elements) <= TIGHTER_SCENE
+        and tight > EXACT_PLACEMENT * analysis.precision.diagonal
+        and _merged_placed_alone(result, tight)
+    ):
+        return result
+    closer = analyse(scene, replace(settings, deviation=tight), cancel=cancel, progress=progress)
+    other = rules_from_analysis(closer, cancel=cancel, progress=progress)
+    # every production it adds must explain two more elements (a repetition places two at
+    # least): at a finer precision, chance coincidences among many elements (a chart's
+    # data) pay for pair rules of their own that explain next to nothing more
+    more = (other.explained - result.explained) * len(scene.elements)
+    added = other.grammar.production_count - result.grammar.production_count
+    return other if more > 0.5 and more >= MIN_EXPLAINED * added else result
+
+
 def infer(
     scene: Scene,
     settings: InferenceSettings = InferenceSettings(),
@@ -428,27 +465,8 @@ def infer(
     t_all = time.perf_counter()
     analysis = analyse(scene, settings, symmetrizing=symmetrizing, cancel=cancel, progress=progress)
     result = rules_from_analysis(analysis, symmetrizing=symmetrizing, cancel=cancel, progress=progress)
-    tight = TIGHTER * analysis.precision.eps
-    if (
-        not symmetrizing
-        and 0.0 < result.explained < 1.0  # cost: distinct shapes (nothing repeats) are not inferred twice
-        and len(scene.elements) <= TIGHTER_SCENE
-        and tight > EXACT_PLACEMENT * analysis.precision.diagonal
-        and _merged_placed_alone(result, tight)
-    ):
-        # A looser tolerance should only buy structure.  When it lets shapes that differ share
-        # a terminal (a symmetric corner merged into asymmetric ones), the terminal's copies
-        # no longer repeat exactly what each kind repeats: keep the tighter description when
-        # its rules explain more of the drawing (it is also the more faithful one).
-        closer = analyse(scene, replace(settings, deviation=tight), cancel=cancel, progress=progress)
-        other = rules_from_analysis(closer, cancel=cancel, progress=progress)
-        # every production it adds must explain two more elements (a repetition places two at
-        # least): at a finer precision, chance coincidences among many elements (a chart's
-        # data) pay for pair rules of their own that explain next to nothing more
-        more = (other.explained - result.explained) * len(scene.elements)
-        added = other.grammar.production_count - result.grammar.production_count
-        if more > 0.5 and more >= MIN_EXPLAINED * added:
-            result = other
+    if not symmetrizing:
+        result = tighter_if_better(analysis, result, cancel=cancel, progress=progress)
     return replace(result, seconds=time.perf_counter() - t_all)
 
 

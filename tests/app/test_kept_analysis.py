@@ -119,3 +119,21 @@ def test_the_first_weight_change_after_opening_reuses_the_worker_analysis(window
     kinds = [kind for kind, _out in outcomes]
     assert kinds == ["open", "settings"]
     assert outcomes[-1][1].reused_analysis and digests == []
+
+
+def test_the_worker_keeps_the_tighter_tolerance_as_infer_does(counted):
+    """Where merged shapes cost a repetition, the editor's rules are the command's: both end
+    with the tighter try (a corner mark's two kinds told apart)."""
+    from tests.core.scenes import scene
+    from tests.core.test_tighter_tolerance import _dashed_hexagon
+
+    sc = scene(_dashed_hexagon(1.06))
+    settings = pipeline.InferenceSettings()
+    full = pipeline.infer(sc, settings)
+    user = pipeline.analyse(sc, settings).precision.eps
+    assert full.tolerance == pytest.approx(pipeline.TIGHTER * user)  # the tighter one was kept
+    first = _infer(sc, settings)
+    assert first.text == format_grammar(full.grammar)
+    reweighted = replace(settings, wh=0.25)
+    again = _infer(sc, reweighted)
+    assert again.text == format_grammar(pipeline.infer(sc, reweighted).grammar)
