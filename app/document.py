@@ -358,9 +358,13 @@ class Document(DocumentFiles, QObject):
             # the worker keeps the analysis of the scene it loaded under this key: later
             # requests name it (the UI thread need not digest the scene)
             self._scene_key = (out.scene, out.scene_key)
+        if kind == "prepare":  # the analysis is kept in the worker: nothing to show
+            self.inferenceFinished.emit()
+            return
         if kind == "reload":
             self.scene, self.scene_path = out.scene, purpose.path
             self.sceneChanged.emit()
+            self._prepare_analysis()
         elif kind == "open":
             self.result = out.result
             self.replace_document(
@@ -403,7 +407,22 @@ class Document(DocumentFiles, QObject):
             TextCommand(self, label, self.text, out.text, grammar=out.grammar, drawing=out.drawing)
         )
 
+    def _prepare_analysis(self) -> None:
+        """Analyse the reloaded scene in the background (a restored session has rules but no analysis).
+
+        The worker keeps it, so the first weight change re-runs only the rules (at 1,200
+        elements ~0.1 s instead of 1.4 s).  A weight change or Re-infer meanwhile supersedes it;
+        a failure says nothing (the next inference reports it).
+        """
+        if self.scene is None or not getattr(self.scene, "elements", ()):
+            return
+        request = InferRequest(self.scene, self.settings, scene_key=self.scene_key(), analyse_only=True)
+        self.inference.submit(Purpose("prepare"), request)
+
     def _on_infer_failed(self, purpose: Purpose, message: str) -> None:
+        if purpose.kind == "prepare":
+            self.inferenceFinished.emit()
+            return
         what = {"open": "Could not open", "reload": "Could not reload"}.get(purpose.kind)
         what = f"{what} {os.path.basename(purpose.path or '')}" if what else "Inference failed"
         self._restore_settings()

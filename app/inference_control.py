@@ -36,7 +36,7 @@ RULE_PURPOSES = ("settings", "reinfer", "symmetrize")
 
 @dataclass(frozen=True)
 class Purpose:
-    """Why a run was started: ``kind`` (``open``, ``reload``, ``settings``, ``reinfer``,
+    """Why a run was started: ``kind`` (``open``, ``reload``, ``prepare``, ``settings``, ``reinfer``,
     ``symmetrize``) and what the document needs to apply its result (a path, the settings and
     the undo merge key of a slider drag)."""
 

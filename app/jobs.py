@@ -55,6 +55,7 @@ class InferRequest:
     svg_path: str | None = None
     limit: int = DERIVE_LIMIT
     load_only: bool = False  # only load ``svg_path`` (restoring a session), no inference
+    analyse_only: bool = False  # only analyse ``scene`` and keep the analysis here, no rules
     scene_key: bytes | None = None  # scene_digest(scene) when the requester knows it
 
 
@@ -104,15 +105,15 @@ def scene_digest(scene: Any) -> bytes:
     return hashlib.blake2b(pickle.dumps(scene, protocol=4), digest_size=20).digest()
 
 
-def infer_kept(
+def keep_analysis(
     scene: Any, settings: Any, cancel: CancelToken, progress: Progress, key: bytes | None = None
 ) -> tuple[Any, bytes, bool]:
-    """Infer ``scene`` with ``settings``, reusing the analysis kept from the same scene.
+    """The analysis of ``scene`` for ``settings``, kept here: reused (and updated) when it is the kept scene.
 
     Only what the settings change is computed again (:func:`lsys_core.pipeline.analyse` with
-    ``previous``); the result is what :func:`lsys_core.pipeline.infer` gives.  ``key`` is the
-    scene's digest if the requester knows it (digesting 1,200 elements takes 11 ms).
-    Returns the result, the key the analysis is kept under and whether the kept one was reused.
+    ``previous``).  ``key`` is the scene's digest if the requester knows it (digesting 1,200
+    elements takes 11 ms).  Returns the analysis, the key it is kept under and whether the kept
+    one was reused.
     """
     key = key or scene_digest(scene)
     previous = _KEPT[0][1] if _KEPT and _KEPT[0][0] == key else None
@@ -122,7 +123,19 @@ def infer_kept(
         _KEPT.clear()  # a new scene: let the old analysis go before the new one is made
     analysis = core.analyse(scene, settings, previous=previous, cancel=cancel, progress=progress)
     _KEPT[:] = [(key, analysis)]
-    return core.rules_from_analysis(analysis, cancel=cancel, progress=progress), key, previous is not None
+    return analysis, key, previous is not None
+
+
+def infer_kept(
+    scene: Any, settings: Any, cancel: CancelToken, progress: Progress, key: bytes | None = None
+) -> tuple[Any, bytes, bool]:
+    """Infer ``scene`` with ``settings``, reusing the analysis kept from the same scene (:func:`keep_analysis`).
+
+    The result is what :func:`lsys_core.pipeline.infer` gives.  Returns the result, the key the
+    analysis is kept under and whether the kept one was reused.
+    """
+    analysis, key, reused = keep_analysis(scene, settings, cancel, progress, key)
+    return core.rules_from_analysis(analysis, cancel=cancel, progress=progress), key, reused
 
 
 def run_inference(request: InferRequest, cancel: CancelToken, progress: Progress) -> InferOutcome:
@@ -131,6 +144,9 @@ def run_inference(request: InferRequest, cancel: CancelToken, progress: Progress
     if request.load_only:  # its key digested here, not on the requester's UI thread
         return InferOutcome(scene, None, "", None, scene_key=scene_digest(scene))
     key, reused = request.scene_key, False
+    if request.analyse_only:  # a restored session: the first weight change will find it
+        _, key, reused = keep_analysis(scene, request.settings, cancel, progress, key)
+        return InferOutcome(None, None, "", None, scene_key=key, reused_analysis=reused)
     if request.symmetrize:
         result = core.symmetrize(scene, request.settings, cancel=cancel, progress=progress)
     else:

@@ -258,6 +258,35 @@ def test_restore_reloads_the_input_in_the_background(qtbot, corpus, inference_pr
     doc.shutdown()
 
 
+def test_after_a_restore_the_first_weight_change_reuses_an_analysis_made_in_the_background(
+    qtbot, corpus, inference_process
+):
+    """The reloaded scene is analysed in the worker without touching the restored rules, so the
+    first weight change re-runs only the rules."""
+    import dataclasses
+
+    from app.document import Document
+
+    doc = Document(infer_compute=inference_process)
+    outcomes = []
+    doc.inference.done.connect(lambda purpose, out: outcomes.append((purpose.kind, out)))
+    state = {
+        "text": "lsys 1\naxiom: ε\n",
+        "settings": {},
+        "scene_path": str(corpus("helix.svg")),
+        "path": None,
+    }
+    doc.restore(state)
+    qtbot.waitUntil(lambda: doc.scene is not None and not doc.busy, timeout=120_000)
+    assert [kind for kind, _ in outcomes] == ["reload", "prepare"]
+    assert doc.text == state["text"] and doc.result is None and doc.undo_stack.count() == 1
+    doc.set_settings(dataclasses.replace(doc.settings, wh=0.5))
+    qtbot.waitUntil(lambda: not doc.busy and len(outcomes) == 3, timeout=120_000)
+    assert outcomes[-1][0] == "settings" and outcomes[-1][1].reused_analysis
+    assert doc.text != state["text"] and doc.undo_stack.count() == 2
+    doc.shutdown()
+
+
 def test_a_typed_weight_starts_at_once_and_a_slider_drag_after_a_pause(window, corpus, wait_idle):
     """A value typed into a spin box is one edit: inference starts without the debounce; the
     steps of a slider drag wait for a pause (each would cancel the one before)."""
