@@ -55,7 +55,7 @@ class InferRequest:
     svg_path: str | None = None
     limit: int = DERIVE_LIMIT
     load_only: bool = False  # only load ``svg_path`` (restoring a session), no inference
-    analyse_only: bool = False  # only analyse ``scene`` and keep the analysis here, no rules
+    analyse_only: bool = False  # only analyse ``scene`` and keep the analysis here (rules not returned)
     scene_key: bytes | None = None  # scene_digest(scene) when the requester knows it
 
 
@@ -145,7 +145,9 @@ def run_inference(request: InferRequest, cancel: CancelToken, progress: Progress
         return InferOutcome(scene, None, "", None, scene_key=scene_digest(scene))
     key, reused = request.scene_key, False
     if request.analyse_only:  # a restored session: the first weight change will find it
-        _, key, reused = keep_analysis(scene, request.settings, cancel, progress, key)
+        # the rules are generated once too (and dropped): that fills the analysis' level cache,
+        # which a weight change reuses as it does after opening a file
+        _, key, reused = infer_kept(scene, request.settings, cancel, progress, key)
         return InferOutcome(None, None, "", None, scene_key=key, reused_analysis=reused)
     if request.symmetrize:
         result = core.symmetrize(scene, request.settings, cancel=cancel, progress=progress)
