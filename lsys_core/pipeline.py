@@ -20,7 +20,7 @@ from lsys_core.errors import InferenceError
 from lsys_core.grammar.model import Grammar
 from lsys_core.hierarchy.cache import LevelCache
 from lsys_core.hierarchy.describe import flat_bits, grammar_bits
-from lsys_core.hierarchy.explain import explained_share, repeating_rules
+from lsys_core.hierarchy.explain import explained_share, placed_by_repetition
 from lsys_core.hierarchy.mdl import Precision
 from lsys_core.hierarchy.pivots import estimate_pivots, recenter
 from lsys_core.hierarchy.postprocess import simplify
@@ -375,9 +375,7 @@ def _merged_placed_alone(result: InferenceResult, tight: float) -> bool:
         return False
     far = {inst.terminals[g].name for g in np.unique(inst.group[inst.deviation > tight])}
     drawing = derive(result.grammar, limit=max(10 * inst.group.size, 1000))
-    repeats = repeating_rules(result.grammar)
-    by_rule = np.array([r.name in repeats for r in result.grammar.rules] + [False], bool)  # -1: the axiom
-    alone = np.unique(drawing.symbol[~by_rule[drawing.rule]])
+    alone = np.unique(drawing.symbol[~placed_by_repetition(result.grammar, drawing.rule)])
     bases = drawing.bases or tuple(range(len(drawing.terminals)))
     return any(drawing.terminals[bases[int(k)]].name in far for k in alone)
 

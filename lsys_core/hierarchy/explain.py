@@ -12,7 +12,7 @@ import numpy as np
 
 from lsys_core.grammar.model import Grammar, Symbol
 
-__all__ = ["explained_share", "repeating_rules"]
+__all__ = ["explained_share", "placed_by_repetition", "repeating_rules"]
 
 
 def repeating_rules(g: Grammar) -> set[str]:
@@ -35,8 +35,8 @@ def repeating_rules(g: Grammar) -> set[str]:
     return out
 
 
-def explained_share(g: Grammar, emitted_by: np.ndarray) -> float:
-    """Share of the derived instances placed by a repeating rule.
+def placed_by_repetition(g: Grammar, emitted_by: np.ndarray) -> np.ndarray:
+    """For every derived instance, whether a repeating rule placed it.
 
     Parameters
     ----------
@@ -46,8 +46,13 @@ def explained_share(g: Grammar, emitted_by: np.ndarray) -> float:
         For every derived instance, the index of the rule whose production placed it (-1: the
         axiom), as :attr:`lsys_core.derive.model.Drawing.rule` gives it.
     """
-    if emitted_by.size == 0:
-        return 0.0
     names = repeating_rules(g)
     mask = np.array([r.name in names for r in g.rules] + [False], bool)  # index -1: the axiom
-    return float(np.mean(mask[np.asarray(emitted_by)]))
+    return mask[np.asarray(emitted_by, np.int64)]
+
+
+def explained_share(g: Grammar, emitted_by: np.ndarray) -> float:
+    """Share of the derived instances placed by a repeating rule (:func:`placed_by_repetition`)."""
+    if emitted_by.size == 0:
+        return 0.0
+    return float(np.mean(placed_by_repetition(g, emitted_by)))
