@@ -213,7 +213,7 @@ def _linear_chains(ctx, sym, ps, problems, prox) -> list[LinearCandidate]:
 def _candidate(sym, ps, prox, chains_e, node_chains, n_pairs, n_nodes, dA, dB) -> LinearCandidate:
     edges = chains_e.nodes % n_pairs
     steps = int(chains_e.lengths[0])
-    step = np.arange(edges.size) - np.repeat(chains_e.offsets[:-1], chains_e.lengths)
+    step = chains_e.positions()
     al = ps.alpha[chains_e.firsts % n_pairs]
     be = ps.beta[chains_e.firsts % n_pairs]
     # Least-squares fit of α0, β0 given the steps (angles unwrapped around the first chain).

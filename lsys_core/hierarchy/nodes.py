@@ -13,6 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lsys_core.hierarchy.flat import Groups, as_groups
+
 __all__ = ["Nodes"]
 
 
@@ -76,7 +78,7 @@ class Nodes:
 
     def merge(
         self,
-        groups: list[np.ndarray],
+        groups: Groups | list[np.ndarray],
         syms: list[int],
         slack: list[float] | None = None,
         starts: tuple[tuple[complex, complex], ...] | None = None,
@@ -85,7 +87,7 @@ class Nodes:
 
         Parameters
         ----------
-        groups : list of ndarray of int
+        groups : Groups or list of ndarray of int
             Disjoint groups of node indices, each with its first node first.
         syms : list of int
             The new node's symbol for every group.
@@ -103,11 +105,11 @@ class Nodes:
         """
         n = len(self)
         keep = np.ones(n, bool)
-        if not groups:
+        if not len(groups):
             return self, np.arange(n)
-        flat = np.concatenate(groups)
+        groups = as_groups(groups)
+        flat, owner = groups.nodes, groups.owner()
         keep[flat] = False
-        owner = np.repeat(np.arange(len(groups)), [g.size for g in groups])
         counts = np.bincount(owner, minlength=len(groups))
         cen = (
             np.bincount(owner, self.center[flat].real, len(groups))
@@ -115,7 +117,7 @@ class Nodes:
         ) / counts
         rad = np.zeros(len(groups))
         np.maximum.at(rad, owner, np.abs(self.center[flat] - cen[owner]) + self.radius[flat])
-        first = np.array([int(g[0]) for g in groups], dtype=np.int64)
+        first = groups.firsts
         kept = np.flatnonzero(keep)
         if slack is None:
             new_slack = np.full(len(groups), np.inf)

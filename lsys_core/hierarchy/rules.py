@@ -394,7 +394,7 @@ def _apply_all(table: SymbolTable, book: _Book, chosen: list[Candidate], nodes: 
         out = emit(table, cand)
         book.add(out.rule, out.log)
         nodes, mapping = nodes.merge(
-            list(out.groups), list(out.syms), list(cand.slack) or None, cand.starts or None
+            out.groups, list(out.syms), list(cand.slack) or None, cand.starts or None
         )
         new = np.arange(len(nodes) - len(out.groups), len(nodes))
         for sid, i in zip(out.syms, new, strict=True):
