@@ -105,15 +105,15 @@ def scene_digest(scene: Any) -> bytes:
     return hashlib.blake2b(pickle.dumps(scene, protocol=4), digest_size=20).digest()
 
 
-def keep_analysis(
+def infer_kept(
     scene: Any, settings: Any, cancel: CancelToken, progress: Progress, key: bytes | None = None
 ) -> tuple[Any, bytes, bool]:
-    """The analysis of ``scene`` for ``settings``, kept here: reused (and updated) when it is the kept scene.
+    """Infer ``scene`` with ``settings``, reusing the analysis kept from the same scene.
 
     Only what the settings change is computed again (:func:`lsys_core.pipeline.analyse` with
-    ``previous``).  ``key`` is the scene's digest if the requester knows it (digesting 1,200
-    elements takes 11 ms).  Returns the analysis, the key it is kept under and whether the kept
-    one was reused.
+    ``previous``); the result is what :func:`lsys_core.pipeline.infer` gives.  ``key`` is the
+    scene's digest if the requester knows it (digesting 1,200 elements takes 11 ms).
+    Returns the result, the key the analysis is kept under and whether the kept one was reused.
     """
     key = key or scene_digest(scene)
     previous = _KEPT[0][1] if _KEPT and _KEPT[0][0] == key else None
@@ -123,19 +123,7 @@ def keep_analysis(
         _KEPT.clear()  # a new scene: let the old analysis go before the new one is made
     analysis = core.analyse(scene, settings, previous=previous, cancel=cancel, progress=progress)
     _KEPT[:] = [(key, analysis)]
-    return analysis, key, previous is not None
-
-
-def infer_kept(
-    scene: Any, settings: Any, cancel: CancelToken, progress: Progress, key: bytes | None = None
-) -> tuple[Any, bytes, bool]:
-    """Infer ``scene`` with ``settings``, reusing the analysis kept from the same scene (:func:`keep_analysis`).
-
-    The result is what :func:`lsys_core.pipeline.infer` gives.  Returns the result, the key the
-    analysis is kept under and whether the kept one was reused.
-    """
-    analysis, key, reused = keep_analysis(scene, settings, cancel, progress, key)
-    return core.rules_from_analysis(analysis, cancel=cancel, progress=progress), key, reused
+    return core.rules_from_analysis(analysis, cancel=cancel, progress=progress), key, previous is not None
 
 
 def run_inference(request: InferRequest, cancel: CancelToken, progress: Progress) -> InferOutcome:
@@ -144,15 +132,13 @@ def run_inference(request: InferRequest, cancel: CancelToken, progress: Progress
     if request.load_only:  # its key digested here, not on the requester's UI thread
         return InferOutcome(scene, None, "", None, scene_key=scene_digest(scene))
     key, reused = request.scene_key, False
-    if request.analyse_only:  # a restored session: the first weight change will find it
-        # the rules are generated once too (and dropped): that fills the analysis' level cache,
-        # which a weight change reuses as it does after opening a file
-        _, key, reused = infer_kept(scene, request.settings, cancel, progress, key)
-        return InferOutcome(None, None, "", None, scene_key=key, reused_analysis=reused)
     if request.symmetrize:
         result = core.symmetrize(scene, request.settings, cancel=cancel, progress=progress)
     else:
         result, key, reused = infer_kept(scene, request.settings, cancel, progress, key)
+        if request.analyse_only:  # a restored session: the first weight change finds the analysis
+            # and its level cache, which generating the rules once filled (they are dropped)
+            return InferOutcome(None, None, "", None, scene_key=key, reused_analysis=reused)
     grammar = replace(result.grammar, randomize=request.randomize)
     text = core.format_grammar(grammar)
     try:
