@@ -39,7 +39,7 @@ def _icon(path: str, style: str) -> QIcon:
     from lsys_core.errors import LsysError
     from lsys_core.grammar.model import Terminal
 
-    from .rules_view import thumbnail
+    from .rule_card import thumbnail
 
     try:
         return QIcon(thumbnail(Terminal("T", path, style), THUMB))

@@ -37,7 +37,7 @@ from PySide6.QtWidgets import (
 )
 
 from . import core
-from .rules_view import thumbnail
+from .rule_card import thumbnail
 
 __all__ = ["StructurePanel"]
 

@@ -6,7 +6,7 @@ import random
 
 import pytest
 
-from app import rules_panel
+from app import highlighter, rules_panel
 from app.rules_panel import RulesEditor
 
 
@@ -63,14 +63,14 @@ def test_a_long_line_is_coloured_at_its_head_and_its_tail_stays_plain(qtbot):
     qtbot.waitUntil(lambda: not editor.highlighter.pending, timeout=10_000)
     ranges = editor.document().findBlockByNumber(1).layout().formats()
     assert ranges, "the head of the line is coloured"
-    assert max(r.start + r.length for r in ranges) <= rules_panel._TOKEN_COLOURS < len(axiom)
+    assert max(r.start + r.length for r in ranges) <= highlighter._TOKEN_COLOURS < len(axiom)
 
 
 def test_changes_at_both_ends_colour_only_the_changed_lines(qtbot, monkeypatch):
     coloured: list[str] = []
-    real = rules_panel.LsysHighlighter.highlightBlock
+    real = highlighter.LsysHighlighter.highlightBlock
     monkeypatch.setattr(
-        rules_panel.LsysHighlighter,
+        highlighter.LsysHighlighter,
         "highlightBlock",
         lambda self, text: coloured.append(text) or real(self, text),
     )
