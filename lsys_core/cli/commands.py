@@ -169,11 +169,12 @@ def _settings(args: argparse.Namespace):
 
 def _png_options(args: argparse.Namespace) -> dict:
     """Check the PNG options before any work; return the keyword arguments of ``encode_png``."""
+    if not getattr(args, "png", None):
+        return {}
+    # imported here: the renderer (skia) is loaded only by commands that write a PNG
     from lsys_core.render.raster import MAX_SIDE
     from lsys_core.render.units import parse_color
 
-    if not getattr(args, "png", None):
-        return {}
     if not (math.isfinite(args.dpi) and 1.0 <= args.dpi <= 10_000.0):
         raise LsysError(f"--dpi must be between 1 and 10,000, got {args.dpi:g}")
     for option in ("width", "height"):

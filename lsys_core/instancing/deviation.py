@@ -18,8 +18,6 @@ and a k-d tree over them (about 2.4 GiB) to confirm what its control points tell
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -97,7 +95,8 @@ def _same_segments(
 
     Returns the bound where it is negligible (0 elsewhere) and the indices of the other elements.
     The segments are compared in blocks of at most :data:`_SAME_BLOCK` (a path of 10^6 segments
-    compared in one pass took about 280 MiB of temporaries).
+    compared in one pass took about 280 MiB of temporaries), all elements' segments one after
+    another (per element in Python, the comparison took 0.6 s for 50,000 leaves).
     """
     n = which.size
     count = np.array([e.cubics.shape[0] for e in elements], np.int64)
@@ -107,20 +106,29 @@ def _same_segments(
     if same.size == 0:
         return out, np.arange(n)
     a_same, b_same = a[same], b[same]
-    bound = np.full(same.size, -np.inf)  # per element of ``same``: the largest gap, the extent
-    extent = np.full(same.size, -np.inf)
-    for pieces in _pieces(count[same], _SAME_BLOCK):
-        own = np.concatenate([_cubics(elements[same[j]])[lo:hi] for j, lo, hi in pieces])
-        posed = np.concatenate([_cubics(shapes[which[same[j]]])[lo:hi] for j, lo, hi in pieces])
-        js = np.array([j for j, _, _ in pieces], np.intp)
-        lens = np.array([hi - lo for _, lo, hi in pieces], np.intp)
-        start = np.array([_cubics(elements[same[j]])[0, 0] for j, _, _ in pieces], complex)
-        owner = np.repeat(np.arange(js.size), lens)
-        gap = np.abs(a_same[js][owner, None] * posed + b_same[js][owner, None] - own).max(axis=1)
-        size = np.abs(own - start[owner, None]).max(axis=1)
-        at = np.cumsum(lens) - lens
-        bound[js] = np.maximum(bound[js], np.maximum.reduceat(gap, at))  # js: distinct in a block
-        extent[js] = np.maximum(extent[js], np.maximum.reduceat(size, at))
+    counts = count[same]
+    ends = np.cumsum(counts)
+    starts = ends - counts
+    total = int(ends[-1])
+    own_parts = [_cubics(elements[i]) for i in same.tolist()]
+    first = np.array([c[0, 0] for c in own_parts], complex)
+    shape_cubics = np.concatenate([_cubics(s) for s in shapes])
+    shape_start = (np.cumsum(shape_count) - shape_count)[which[same]]
+    gap = np.empty(total)  # per segment of the elements of ``same``, one after another
+    size = np.empty(total)
+    for lo in range(0, total, _SAME_BLOCK):
+        hi = min(lo + _SAME_BLOCK, total)
+        seg = np.arange(lo, hi)
+        owner = np.searchsorted(ends, seg, side="right")  # index into ``same``
+        j0, j1 = int(owner[0]), int(owner[-1])
+        own = np.concatenate(
+            [own_parts[j][max(lo - int(starts[j]), 0) : hi - int(starts[j])] for j in range(j0, j1 + 1)]
+        )
+        posed = shape_cubics[shape_start[owner] + (seg - starts[owner])]
+        gap[lo:hi] = np.abs(a_same[owner, None] * posed + b_same[owner, None] - own).max(axis=1)
+        size[lo:hi] = np.abs(own - first[owner, None]).max(axis=1)
+    bound = np.maximum.reduceat(gap, starts)  # per element of ``same``: the largest gap, the extent
+    extent = np.maximum.reduceat(size, starts)
     ok = bound <= np.maximum(exact, _NEGLIGIBLE * extent)
     out[same[ok]] = bound[ok]
     todo = np.ones(n, bool)
@@ -130,27 +138,6 @@ def _same_segments(
 
 def _cubics(e: Element) -> np.ndarray:
     return np.asarray(e.cubics, complex).reshape(-1, 4)
-
-
-def _pieces(counts: np.ndarray, block: int) -> Iterator[list[tuple[int, int, int]]]:
-    """Split the segments of items (``counts`` each) into blocks of at most ``block`` segments.
-
-    Yields, per block, its pieces ``(item, lo, hi)``: segments ``lo:hi`` of ``item``, in order.
-    """
-    got: list[tuple[int, int, int]] = []
-    room = block
-    for j, k in enumerate(counts.tolist()):
-        lo = 0
-        while lo < k:
-            hi = lo + min(k - lo, room)
-            got.append((j, lo, hi))
-            room -= hi - lo
-            lo = hi
-            if room == 0:
-                yield got
-                got, room = [], block
-    if got:
-        yield got
 
 
 def pose_deviations(

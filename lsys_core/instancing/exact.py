@@ -24,7 +24,7 @@ _MAX_SEGMENTS = 96
 def structure_key(element: Element) -> tuple:
     """Return a hashable description of the element's segment and subpath structure."""
     sub = np.asarray(element.subpaths)
-    return (int(sub.size), sub.tobytes(), tuple(bool(c) for c in element.closed))
+    return (int(sub.size), sub.tobytes(), tuple(map(bool, element.closed)))
 
 
 def variants(element: Element) -> np.ndarray | None:

@@ -25,7 +25,6 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.ndimage import distance_transform_edt
 from scipy.spatial import cKDTree
 
 from lsys_core.instancing.deviation import pose_deviations
@@ -122,6 +121,10 @@ class _Fields:
         """The fields of all shapes of ``frames`` (one small transform per shape, not per pair)."""
         reach = float(np.abs(frames.unit).max()) * 1.001 + 1e-9 if frames.unit.size else 1.0
         out = cls(np.empty((frames.unit.shape[0], _GRID * _GRID), np.float32), reach, 2.0 * reach / _GRID)
+        # imported here: only scenes with several near-identical terminals get here, and importing
+        # scipy.ndimage took about 50 ms of every run
+        from scipy.ndimage import distance_transform_edt
+
         for k, z in enumerate(frames.unit):
             grid = np.ones((_GRID, _GRID), bool)
             grid[out.cell(z)] = False

@@ -96,7 +96,8 @@ def regular_scales(scene: Scene, inst: Instancing, tolerance: float) -> Instanci
     shapes = terminal_shapes(inst)
     a1 = inst.a[off] / np.abs(inst.a[off])
     # keep the centroid of the terminal's outline where it was
-    cen = np.array([np.mean(shapes[g].cubics) for g in inst.group[off]])
+    groups, where = np.unique(inst.group[off], return_inverse=True)
+    cen = np.array([np.mean(shapes[g].cubics) for g in groups.tolist()])[where.ravel()]
     b1 = inst.b[off] + (inst.a[off] - a1) * cen
     d = pose_deviations(
         [scene.elements[i] for i in off], shapes, inst.group[off], a1, b1, exact=_EXACT * tolerance

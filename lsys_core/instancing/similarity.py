@@ -27,7 +27,13 @@ from lsys_core.instancing.exact import EXACT_TOL, fit_exact, structure_key, vari
 from lsys_core.instancing.match import PERFECT, match_batch
 from lsys_core.instancing.model import Instancing
 from lsys_core.instancing.reference import Batch, Reference
-from lsys_core.instancing.sampling import Samples, arc_fractions, element_features, sample_elements
+from lsys_core.instancing.sampling import (
+    Samples,
+    arc_fractions,
+    element_features,
+    sample_all,
+    sample_elements,
+)
 from lsys_core.instancing.symmetry import canonical, symmetry_order
 from lsys_core.parallel import pmap
 from lsys_core.svg.model import Element, Scene
@@ -73,24 +79,6 @@ def _style_key(style: str) -> str:
     return ""
 
 
-def _sample_all(elements, fractions, cancel, progress=None) -> Samples:
-    """Sample all elements in chunks, checking the cancel token in between.
-
-    Only single open paths are sampled precisely: their poses are pinned down by arc length
-    (closed outlines are matched through foot points, where sample placement does not matter).
-    """
-    precise = np.array([len(e.closed) == 1 and not e.closed[0] for e in elements], dtype=bool)
-
-    def chunk(lo: int) -> Samples:
-        check(cancel)
-        hi = lo + 4 * _CHUNK
-        return sample_elements(elements[lo:hi], fractions, precise[lo:hi])
-
-    parts = pmap(chunk, range(0, len(elements), 4 * _CHUNK))  # fixed chunks: same samples for any jobs
-    report(progress, _STAGE, 0.1)
-    return Samples(*(np.concatenate([getattr(p, f) for p in parts]) for f in Samples.__dataclass_fields__))
-
-
 class _Rep:
     """A representative: its element index, local origin (centroid), size and reference."""
 
@@ -102,7 +90,7 @@ class _Rep:
         self.origin = complex(dense.points[0].mean())
         rel = dense.points[0] - self.origin
         self.radius = float(np.sqrt(np.mean(np.abs(rel) ** 2)))
-        row = Samples(*(getattr(coarse, f)[index : index + 1] for f in Samples.__dataclass_fields__))
+        row = coarse.rows(slice(index, index + 1))
         open_path = len(element.closed) == 1 and not element.closed[0]
         self.ref = Reference.build(row, dense, fractions, element.cubics, self.origin, self.radius, open_path)
         self.control = np.asarray(element.cubics, dtype=complex).ravel()
@@ -229,12 +217,11 @@ def detect_similarity(
     if n == 0:
         empty = np.zeros(0, dtype=int)
         return Instancing(empty, np.zeros(0, complex), np.zeros(0, complex), (), empty, empty.copy())
-    coarse = _sample_all(elements, arc_fractions(_SAMPLES), cancel, progress)
-    centroid, radius, desc = element_features(coarse)
-    extent = np.abs(coarse.points - centroid[:, None]).max(axis=1)
-    span = np.maximum(np.abs(coarse.points).max(axis=1), 1.0)
-    degenerate = (coarse.length <= 1e-9 * span) | (radius <= 1e-9 * span) | ~np.isfinite(radius)
-    degenerate |= extent <= 1e-9 * span
+    # arc length tabulated per 4,096 elements: the same samples for any number of workers
+    coarse, centroid, radius, desc, degenerate = sample_all(
+        elements, arc_fractions(_SAMPLES), 4 * _CHUNK, cancel
+    )
+    report(progress, _STAGE, 0.1)
     parsed = {st: _style_key(st) for st in {e.style for e in elements}}
     key_ids = {k: i for i, k in enumerate(dict.fromkeys(parsed[e.style] for e in elements))}
     key_of = np.array([key_ids[parsed[e.style]] for e in elements])
