@@ -169,6 +169,10 @@ class ArcTable:
         Every element's first and last eighth (``last < first`` for an element without cubics).
     start, length : ndarray of float, shape (n,)
         Every element's place in ``cum`` and its arc length.
+    chord : ndarray of complex, shape (K,)
+        Every cubic's end less its start.
+    tiny : ndarray of float, shape (K,)
+        Derivatives this small are no direction on the cubic (``1e-12`` of its largest coordinate, at least ``1e-12``).
     """
 
     cubics: np.ndarray
@@ -178,6 +182,8 @@ class ArcTable:
     last: np.ndarray
     start: np.ndarray
     length: np.ndarray
+    chord: np.ndarray
+    tiny: np.ndarray
 
     @property
     def size(self) -> int:
@@ -207,7 +213,9 @@ def arc_table(elements: list[Element] | tuple[Element, ...]) -> ArcTable:
         end = np.where(present, cum[np.minimum(last, chords.size - 1) + 1], 0.0)
     else:
         start = end = np.zeros(n)
-    return ArcTable(cubics, chords, cum, first, last, start, end - start)
+    chord = cubics[:, 3] - cubics[:, 0]
+    tiny = 1e-12 * np.maximum(np.abs(cubics).max(axis=-1), 1.0) if cubics.shape[0] else np.zeros(0)
+    return ArcTable(cubics, chords, cum, first, last, start, end - start, chord, tiny)
 
 
 def empty_samples(n: int, s: int) -> Samples:
@@ -260,10 +268,9 @@ def sample_rows(
             )
         t[rows] = tr
     pos, d1, d2 = bezier(c_seg, t)
-    chord_dir = c_seg[..., 3] - c_seg[..., 0]
-    tiny = 1e-12 * np.maximum(np.abs(c_seg).max(axis=-1), 1.0)
-    tangent = np.where(np.abs(d1) > tiny, d1, np.where(np.abs(d2) > tiny, d2, chord_dir))
+    tiny = table.tiny[seg]  # per cubic, not per sample: the same numbers
     speed = np.abs(d1)
+    tangent = np.where(speed > tiny, d1, np.where(np.abs(d2) > tiny, d2, table.chord[seg]))
     cross = d1.real * d2.imag - d1.imag * d2.real
     out.curvature[rows_out] = np.where(speed > tiny, np.abs(cross) / np.maximum(speed, tiny) ** 3, 0.0)
     mag = np.abs(tangent)
