@@ -27,3 +27,20 @@ def test_infer_path_does_not_import_skia() -> None:
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.stdout.strip() == "False"
+
+
+def test_an_inference_to_rules_loads_no_renderer_and_no_image_filters(tmp_path) -> None:
+    # Both are imported where they are used (a PNG to write; distance fields of near-identical
+    # terminals): an inference of exact copies that writes only rules loads neither.
+    svg = tmp_path / "a.svg"
+    leaves = "".join(f'<path d="M{20 * i},0 q5,-8 14,-2 q-5,4 -14,2 z"/>' for i in range(6))
+    svg.write_text(f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 200 40">{leaves}</svg>')
+    out = tmp_path / "a.lsys"
+    code = (
+        "import sys\nfrom lsys_core.cli import main\n"
+        f"status = main(['-q', 'infer', {str(svg)!r}, '-o', {str(out)!r}])\n"
+        "print(status, 'lsys_core.render.raster' in sys.modules, 'scipy.ndimage' in sys.modules)"
+    )
+    got = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert got.stdout.split() == ["0", "False", "False"], got.stderr
+    assert "->" in out.read_text()
