@@ -4,18 +4,21 @@ The text is classified byte by byte with a lookup table; number boundaries (``1-
 ``1e-3``) follow from shifted boolean arrays, malformed numbers (``1e``, ``.``, ``-``) are found
 with a few gathers, and the values are read by numpy's C parser from a copy of the text in which
 every token is separated by a space (correctly rounded, like :func:`float`).  The text is processed
-in chunks of about a megabyte cut at separators, so temporary memory is bounded whatever the length;
-work is linear in the length and the result holds three numbers per token.
+in chunks of about a megabyte cut at separators, so temporary memory is bounded whatever the length
+(one chunk per worker at a time: :func:`lsys_core.parallel.jobs`); work is linear in the length and
+the result holds three numbers per token.
 """
 
 from __future__ import annotations
 
+import itertools
 import re
 from typing import NamedTuple
 
 import numpy as np
 
 from lsys_core.errors import LimitError
+from lsys_core.parallel import jobs, pmap
 
 __all__ = ["COMMAND_LETTERS", "Lexed", "lex", "numbers_from_text"]
 
@@ -80,7 +83,7 @@ def lex(
     letters : bool
         Whether path command letters are tokens (otherwise they are errors).
     chunk : int
-        Bytes lexed at a time (bounds the temporary memory).
+        Bytes lexed at a time by each worker (bounds the temporary memory).
     max_numbers : int, optional
         Most numbers accepted (checked after each chunk, before more memory is used).
 
@@ -101,18 +104,22 @@ def lex(
                 raise LimitError(f"more than {max_numbers:,} numbers in path data")
             return quick
     whole = np.frombuffer(raw, dtype=np.uint8)
+    bounds = [0]
+    while bounds[-1] < whole.size:
+        bounds.append(_cut(whole, bounds[-1] + chunk))
+    pieces = list(itertools.pairwise(bounds))
     parts: list[tuple[np.ndarray, ...]] = []
-    a = 0
     count = 0
-    n = whole.size
-    while a < n:
-        b = _cut(whole, a + chunk)
-        vals, starts, lets, lpos, errs = _lex_chunk(whole[a:b], letters)
-        parts.append((vals, starts + a, lets, lpos + a, errs + a))
-        count += vals.size
+    step = jobs()  # chunks lexed at once, one a worker (numpy's parsers release the GIL)
+    for first in range(0, len(pieces), step):
+        batch = pieces[first : first + step]
+        for (a, _), (vals, starts, lets, lpos, errs) in zip(
+            batch, pmap(lambda ab: _lex_chunk(whole[ab[0] : ab[1]], letters), batch), strict=True
+        ):
+            parts.append((vals, starts + a, lets, lpos + a, errs + a))
+            count += vals.size
         if max_numbers is not None and count > max_numbers:
             raise LimitError(f"more than {max_numbers:,} numbers in path data")
-        a = b
     if not parts:
         z = np.zeros(0, dtype=np.int64)
         return Lexed(np.zeros(0), z, np.zeros(0, np.uint8), z, z)

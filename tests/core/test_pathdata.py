@@ -46,6 +46,25 @@ def test_lexing_in_chunks_gives_the_same_tokens():
     assert whole.values.size == 12000  # "L0.370-1e-1,1.5.25": 0.37, -1e-1, 1.5, .25
 
 
+def test_chunks_lexed_on_several_workers_give_the_same_tokens_and_limit():
+    from lsys_core import parallel
+    from lsys_core.errors import LimitError
+
+    text = " ".join(f"L{i * 0.37:.3f}-{i}e-1,{i}.5.25 x" for i in range(3000))  # with errors
+    try:
+        parallel.set_jobs(1)
+        one = lex(text, chunk=97)
+        for jobs in (2, 3):
+            parallel.set_jobs(jobs)
+            got = lex(text, chunk=97)
+            assert all(np.array_equal(x, y) for x, y in zip(got, one, strict=True))
+            with pytest.raises(LimitError, match="more than 5,000 numbers"):
+                lex(text, chunk=97, max_numbers=5000)
+    finally:
+        parallel.set_jobs(None)
+    assert one.errors.size == 3000
+
+
 def _reference(d: str) -> list[tuple[complex, complex, complex, complex, str]]:
     """A plain sequential reading of simple, well-formed data (no arcs) after the SVG spec."""
     toks = d.replace(",", " ").split()
