@@ -102,7 +102,10 @@ def _tries(settings: InferenceSettings, symmetrizing: bool, n: int, drawn_by_han
     repetition.  Like every try it is kept only when its grammar is the shortest (minimum
     description length), so drawings where the floor merges distinct transforms keep the
     grammar without it.  The floor measures how far copies' outlines deviate from their
-    terminal: without ``drawn_by_hand`` (every copy exact) it is not tried.  Large scenes try
+    terminal: without ``drawn_by_hand`` (every copy exact, up to the precision SVG coordinates
+    are written at, :data:`EXACT_PLACEMENT`) it is not tried: a floor of rounding noise is far
+    below the bandwidths, and its try repeated the plain one (a chart of 435 ticks whose shapes
+    deviate by 3e-16 of the diagonal ran ten tries, five of them the same as the other five).  Large scenes try
     fewer relaxed factors and no floor: each try is a whole rule generation.
     """
     steps: tuple[float, ...]
@@ -307,7 +310,8 @@ def rules_from_analysis(
     copies = inst.stretch_base if inst.stretch_base is not None else np.full(len(inst.terminals), -1)
     drawn = tuple(t for t, c in zip(inst.terminals, copies, strict=True) if c < 0)
     best: tuple[Grammar, Hierarchy, float, float, Drawing] | None = None
-    for tol in _tries(settings, symmetrizing, len(scene.elements), bool(np.any(shape_dev > 0))):
+    by_hand = bool(np.any(shape_dev > EXACT_PLACEMENT * diag))  # beyond rounding: see _tries
+    for tol in _tries(settings, symmetrizing, len(scene.elements), by_hand):
         check(cancel)
         hier = build_hierarchy(
             [t.name for t in inst.terminals],

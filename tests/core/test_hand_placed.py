@@ -107,3 +107,37 @@ def test_a_window_matched_upside_down_is_turned_like_its_neighbours() -> None:
     dev = an.instancing.deviation
     assert dev is not None and dev[windows].max() <= 0.5 * an.precision.eps
     # exact copies of a nearly symmetric leaf keep their turns: tests/core/test_mdl.py's rings
+
+
+def _tolerances_tried(sc, monkeypatch) -> list:
+    """The clustering tolerances rule generation tries for scene ``sc``."""
+    import lsys_core.pipeline as pipeline
+
+    tried = []
+    real = pipeline.build_hierarchy
+
+    def spy(*args, **kwargs):
+        tried.append(kwargs["tol"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(pipeline, "build_hierarchy", spy)
+    infer(sc)
+    return tried
+
+
+def test_copies_exact_up_to_rounding_try_no_noise_floor(monkeypatch) -> None:
+    # copies placed at turns whose sines and cosines round: deviations of ~1e-16, not drawing noise
+    turns = np.exp(1j * np.deg2rad(np.array([0.0, 33.3, 71.7, 123.1, 201.9])))
+    row = place(
+        _polygon([0, 4.5, 4.5 + 5.5j, 5.5j]), [(t, complex(20 + 17 * k, 60)) for k, t in enumerate(turns)]
+    )
+    sc = scene(_background(), row)
+    deviation = analyse(sc).instancing.deviation
+    assert deviation is not None and np.any(deviation > 0)  # rounding: some copies are "off"
+    tried = _tolerances_tried(sc, monkeypatch)
+    assert len(tried) > 1 and all(t.length == 0 for t in tried)
+
+
+def test_copies_drawn_by_hand_try_the_noise_floor(monkeypatch) -> None:
+    tried = _tolerances_tried(scene(_background(), _window_row(0), _ring(1, "dot")), monkeypatch)
+    assert any(t.length > 0 for t in tried)
