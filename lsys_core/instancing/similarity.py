@@ -240,6 +240,7 @@ def detect_similarity(
     mirror_of: list[int] = []
     pending: deque[tuple[int, int]] = deque()
     cursor = 0
+    done = 0  # elements in a group (counted as they join: counting the array each time is quadratic)
     while True:
         check(cancel)
         if pending:
@@ -256,8 +257,11 @@ def detect_similarity(
         rep_index.append(r)
         mirror_of.append(mirror)
         group[r] = g
+        done += 1
         if degenerate[r]:
-            group[degenerate & (key_of == key_of[r]) & (group < 0)] = g
+            alike = degenerate & (key_of == key_of[r]) & (group < 0)
+            group[alike] = g
+            done += int(np.count_nonzero(alike))
             reps.append(None)
             continue
         rep = _Rep(elements[r], r, coarse)
@@ -281,12 +285,13 @@ def detect_similarity(
         for chunk, (ok, mirrored, pa, pb) in zip(chunks, pmap(verify, chunks), strict=True):
             flipped.append(chunk[mirrored])
             group[chunk[ok]] = g
+            done += int(np.count_nonzero(ok))
             a[chunk[ok]], b[chunk[ok]] = pa[ok], pb[ok]
-            report(progress, _STAGE, 0.1 + 0.85 * float(np.count_nonzero(group >= 0)) / n)
+            report(progress, _STAGE, 0.1 + 0.85 * done / n)
         found = np.concatenate(flipped) if flipped else np.zeros(0, int)
         if found.size:
             pending.append((int(found.min()), g))
-        report(progress, _STAGE, 0.1 + 0.85 * float(np.count_nonzero(group >= 0)) / n)
+        report(progress, _STAGE, 0.1 + 0.85 * done / n)
     symmetry = np.ones(len(rep_index), dtype=int)
     terminals = []
     for g, (r, rep_g) in enumerate(zip(rep_index, reps, strict=True)):

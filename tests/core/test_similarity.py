@@ -451,3 +451,13 @@ def test_many_sided_polygon_reports_continuous_but_keeps_its_true_period():
     assert inst.group.tolist() == [0, 0]
     assert inst.symmetry.tolist() == [0]
     assert np.isclose(np.angle(inst.a[1], deg=True), 7.5) and np.isclose(abs(inst.a[1]), 2)
+
+
+def test_progress_counts_every_grouped_element_once():
+    # a degenerate (zero-size) element, distinct shapes (a representative each) and copies
+    square = np.array([[0, 0, 0, 0], [0, 10, 10, 10], [10, 10 + 10j, 10 + 10j, 10 + 10j]], complex)
+    els = [el(np.zeros((1, 4), complex) + 7), el(LEAF), el(LEAF + 50), el(LEAF * 1j + 100), el(square + 200)]
+    seen: list[float] = []
+    detect_similarity(Scene(tuple(els)), progress=lambda s, f: seen.append(f))
+    assert seen == sorted(seen)  # never goes back
+    assert seen[-1] == 1.0 and seen[-2] == pytest.approx(0.95)  # all elements grouped before the end
