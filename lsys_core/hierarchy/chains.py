@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from lsys_core.hierarchy.flat import Groups, follow_links, greedy_links, isin, sorted_unique
+from lsys_core.hierarchy.sorting import first_occurrences, stable_argsort
 
 __all__ = ["Linked", "chains", "edge_chains", "edge_groups", "follow", "link_clusters", "successor_pairs"]
 
@@ -74,7 +75,7 @@ def link_clusters(
     starts = sorted_unique(a_src[~isin(a_src, a_dst)])  # per cluster, in node order
     paths, loops = follow_links(a_src, a_dst, starts)
     allc = paths.concat(loops)
-    allc = allc.take(np.argsort(allc.firsts // n, kind="stable"))  # per cluster: paths, then rings
+    allc = allc.take(stable_argsort(allc.firsts // n))  # per cluster: paths, then rings
     # The pair along every link of the chains: the taken pair leaving the link's first node.
     srt = np.argsort(a_src)
     lo, _ = allc.links()
@@ -122,7 +123,7 @@ def follow(succ: dict[int, int], starts) -> tuple[list[list[int]], list[list[int
 
 def successor_pairs(src: np.ndarray, dst: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """All pairs of pairs ``(i→j, j→k)`` with ``k != i`` among the pair indices ``idx``."""
-    order = np.argsort(src[idx], kind="stable")
+    order = stable_argsort(src[idx])
     s_sorted = src[idx][order]
     lo = np.searchsorted(s_sorted, dst[idx], "left")
     cnt = np.searchsorted(s_sorted, dst[idx], "right") - lo
@@ -139,10 +140,10 @@ def edge_groups(e1: np.ndarray, e2: np.ndarray) -> Groups:
     Paths come in the order of their first links; closed loops (a ring of dots) are cut
     before their smallest pair and lose the closing one.
     """
-    _, first = np.unique(e1, return_index=True)
-    e1, e2 = e1[np.sort(first)], e2[np.sort(first)]
-    _, first = np.unique(e2, return_index=True)
-    e1, e2 = e1[np.sort(first)], e2[np.sort(first)]
+    first = first_occurrences(e1)
+    e1, e2 = e1[first], e2[first]
+    first = first_occurrences(e2)
+    e1, e2 = e1[first], e2[first]
     keep = e1 != e2
     s, d = e1[keep], e2[keep]
     paths, loops = follow_links(s, d, s[~isin(s, d)])

@@ -14,8 +14,10 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from lsys_core import parallel
+from lsys_core.hierarchy.flat import sorted_unique
+from lsys_core.hierarchy.sorting import stable_argsort
 
-__all__ = ["group_indices", "mean_shift"]
+__all__ = ["RANK", "group_indices", "mean_shift", "rank_order", "ranked_mean_shift"]
 
 #: Up to this many points, the labels come from one KD-tree query (cheaper than per-cell reasoning).
 _DIRECT = 20_000
@@ -27,6 +29,8 @@ _NEAR = 8
 #: at every call, and a drawing of 4,817 elements makes 5,282 mostly small calls (48 s in
 #: thread joins when every call was threaded).
 _THREADED = 20_000
+#: The fields of :func:`ranked_mean_shift`'s cluster keys.
+RANK = np.dtype([("size", np.int64), ("support", np.float64), ("seed", np.int64)])
 
 
 def _row_keys(cells: np.ndarray) -> np.ndarray:
@@ -65,7 +69,7 @@ def _ball_pairs(query: np.ndarray, tree: cKDTree, r: float = 1.0) -> tuple[np.nd
     whose :data:`_NEAR` nearest are all within ``r`` may have more, and only those go through
     ``sparse_distance_matrix``.  Most seeds of a pair space are nearly isolated: for 10^5 of
     them the query takes 0.20 s of CPU where ``sparse_distance_matrix`` took 0.25 s, and a
-    large query runs on every core.
+    large query runs on every core.  Each query's points come in increasing order of ``j``.
     """
     k = min(_NEAR, tree.n)
     workers = parallel.jobs() if len(query) >= _THREADED else 1  # threads cost ~1 ms per call
@@ -74,12 +78,18 @@ def _ball_pairs(query: np.ndarray, tree: cKDTree, r: float = 1.0) -> tuple[np.nd
     inside = dist <= r
     full = np.flatnonzero(inside[:, -1]) if k < tree.n else np.zeros(0, np.intp)
     inside[full] = False
-    i, col = np.nonzero(inside)
+    # Every query's points in increasing order, whatever the tree: sums over them are then
+    # the same bit for bit when the points are those of a part of the tree (ranked_mean_shift).
+    idx = np.where(inside, idx, tree.n)
+    idx.sort(axis=1)
+    i, col = np.nonzero(idx < tree.n)
     j = idx[i, col]
     if full.size:
         pairs = cKDTree(query[full]).sparse_distance_matrix(tree, r, output_type="ndarray")
-        i = np.concatenate([i, full[pairs["i"]]])
-        j = np.concatenate([j, pairs["j"]])
+        fi, fj = full[pairs["i"]], pairs["j"]
+        by = np.lexsort((fj, fi))
+        i = np.concatenate([i, fi[by]])
+        j = np.concatenate([j, fj[by]])
     return i.astype(np.intp), j.astype(np.intp)
 
 
@@ -96,7 +106,7 @@ def _suppress(seeds: np.ndarray, order: np.ndarray) -> np.ndarray:
         return order
     a = np.concatenate([pairs[:, 0], pairs[:, 1]])
     b = np.concatenate([pairs[:, 1], pairs[:, 0]])
-    by = np.argsort(a, kind="stable")
+    by = stable_argsort(a)
     a, b = a[by], b[by]
     lo = np.searchsorted(a, np.arange(len(seeds)))
     hi = np.searchsorted(a, np.arange(len(seeds)), side="right")
@@ -202,17 +212,42 @@ def mean_shift(
     modes : ndarray, shape (c, k)
         The cluster modes.
     """
+    labels, modes, _ = ranked_mean_shift(points, max_iter=max_iter, min_count=min_count)
+    return labels, modes
+
+
+def ranked_mean_shift(
+    points: np.ndarray, *, max_iter: int = 30, min_count: int = 1
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`mean_shift`, with the key that puts every cluster in its place (clustering in parts).
+
+    Points farther than a bandwidth from every other part's never meet (no seed climbs across
+    the gap), so a mean shift of the whole is that of its parts: the same clusters and modes,
+    bit for bit (every seed sums its neighbours in the same order, see :func:`_ball_pairs`).
+    Only the numbering is global: clusters are sorted by decreasing size, then by decreasing
+    support of their mode, then by their seed's cell key.  :func:`rank_order` of the parts'
+    keys, concatenated, gives the clusters in the order of one mean shift of all the points
+    (a point equally near two modes may take either, as with one call).
+
+    Returns
+    -------
+    labels, modes : ndarray
+        As :func:`mean_shift`.
+    rank : ndarray of :data:`RANK`, shape (c,)
+        Per cluster: its size, its mode's support and its seed's cell key (a point farther
+        than a bandwidth from every mode, a cluster of its own: support -1 and its index).
+    """
     pts = np.asarray(points, dtype=float)
     n = pts.shape[0]
     if n == 0:
-        return np.zeros(0, int), np.zeros((0, pts.shape[1] if pts.ndim == 2 else 0))
-    if n == 1:
-        return np.zeros(1, int), pts.copy()
+        return np.zeros(0, int), np.zeros((0, pts.shape[1] if pts.ndim == 2 else 0)), np.zeros(0, RANK)
     # Bin seeding on half-bandwidth cells: weighted centroids of occupied cells.
     keys = np.concatenate(
         [_row_keys(np.floor(pts[lo : lo + _BLOCK] * 2.0).astype(np.int64)) for lo in range(0, n, _BLOCK)]
     )  # in blocks: three temporaries of the size of the points for 6·10^6 points were 0.7 GiB
-    cells = np.unique(keys)  # a plain sort: ``return_inverse`` sorts indices, 2.3x slower at 5·10^6
+    if n == 1:
+        return np.zeros(1, int), pts.copy(), np.array([(1, 1.0, keys[0])], RANK)
+    cells = sorted_unique(keys)  # a plain sort: numpy's hashing took 15 s for 5·10^6 distinct keys
     inv = np.searchsorted(cells, keys)
     del keys
     counts = np.bincount(inv, minlength=cells.size)
@@ -249,21 +284,34 @@ def mean_shift(
     order = order[support[order] >= min_count]
     keep_idx = _suppress(seeds, order)
     if not keep_idx.size:
-        return np.full(n, -1), np.zeros((0, pts.shape[1]))
+        return np.full(n, -1), np.zeros((0, pts.shape[1])), np.zeros(0, RANK)
     mode_arr = seeds[keep_idx]
     lab = _nearest_mode(pts, mode_arr, cent, inv)
     # Points farther than a bandwidth from every mode form their own singleton clusters.
     lone = np.flatnonzero(lab < 0)
+    rank = np.zeros(keep_idx.size + lone.size, RANK)
+    rank["support"] = np.concatenate([support[keep_idx], np.full(lone.size, -1.0)])
+    rank["seed"] = np.concatenate([cells[keep_idx], lone])
     if lone.size:
         lab[lone] = mode_arr.shape[0] + np.arange(lone.size)
         mode_arr = np.vstack([mode_arr, pts[lone]])
     # Sort clusters by size (largest first).
     sizes = np.bincount(lab, minlength=mode_arr.shape[0])
-    rank = np.argsort(-sizes, kind="stable")
-    remap = np.empty_like(rank)
-    remap[rank] = np.arange(rank.size)
-    keep = sizes[rank] > 0
-    return remap[lab], mode_arr[rank][keep]
+    rank["size"] = sizes
+    by = np.argsort(-sizes, kind="stable")
+    remap = np.empty_like(by)
+    remap[by] = np.arange(by.size)
+    keep = sizes[by] > 0
+    return remap[lab], mode_arr[by][keep], rank[by][keep]
+
+
+def rank_order(rank: np.ndarray) -> np.ndarray:
+    """The order of clusters keyed by :func:`ranked_mean_shift` (keys of several parts, concatenated).
+
+    Within one call's keys this is ``arange``; over the parts of a point set, the order of
+    the clusters of one call on all the points (lone points of a part: by their index in it).
+    """
+    return np.lexsort((rank["seed"], -rank["support"], -rank["size"]))
 
 
 def group_indices(labels: np.ndarray) -> list[np.ndarray]:
@@ -273,6 +321,6 @@ def group_indices(labels: np.ndarray) -> list[np.ndarray]:
     within a cluster the indices are increasing.
     """
     labels = np.asarray(labels)
-    order = np.argsort(labels, kind="stable")
+    order = stable_argsort(labels)
     cuts = np.flatnonzero(np.diff(labels[order])) + 1
     return [g for g in np.split(order, cuts) if g.size and labels[g[0]] >= 0]

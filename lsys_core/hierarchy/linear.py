@@ -14,19 +14,23 @@ from lsys_core import parallel
 from lsys_core.geometry.transforms import wrap_deg
 from lsys_core.hierarchy.candidates import Context, LinearCandidate
 from lsys_core.hierarchy.chains import edge_groups, successor_pairs
-from lsys_core.hierarchy.clustering import group_indices, mean_shift
+from lsys_core.hierarchy.clustering import RANK, mean_shift, rank_order, ranked_mean_shift
 from lsys_core.hierarchy.flat import Groups, greedy_disjoint, sorted_unique
 from lsys_core.hierarchy.gain import Ledger, cluster_bounds
+from lsys_core.hierarchy.sorting import row_groups, stable_argsort
 from lsys_core.hierarchy.spaces import PairSpace
 
 __all__ = ["linear_candidates"]
 
 #: Step clusters (Δα, Δβ) examined per (d, s) cluster, largest first: smaller ones cannot win.
 _STEP_CLUSTERS = 12
-#: Consecutive pairs from which the chains of the step clusters are solved in several runs.
+#: (d, s) clusters are examined in parts of up to this many pairs (a larger cluster is a part of
+#: its own): a part's consecutive pairs (about 7 per pair in a grid) are all its memory.
+_PART = 100_000
+#: Consecutive pairs from which the chains of a part's step clusters are solved in several runs.
 _SPLIT = 200_000
 #: Consecutive pairs solved in one run at most (unless one step cluster has more): a run's
-#: arrays take about 100 bytes per pair, and two runs at a time held 0.9 GiB at 100,000 elements.
+#: arrays take about 100 bytes per pair.
 _BATCH = 500_000
 
 
@@ -44,6 +48,12 @@ def linear_candidates(
 
     ``size`` is every pair's source size and ``xy`` its translation bandwidth.  With a
     ``ledger``, clusters that cannot shorten the description are skipped.
+
+    Consecutive pairs never leave their (d, s) cluster, so the clusters are examined in parts
+    (:data:`_PART`) on :func:`lsys_core.parallel.jobs` threads, each part holding only its
+    own consecutive pairs (10^7 at 100,000 elements); the step clusters of all parts are then
+    put in the order of one mean shift of all of them (:func:`ranked_mean_shift`): the result
+    does not depend on the parts or the number of workers.
     """
     tol = ctx.tol
     ok = (ps.d / size > 0.1) & (sym[ps.src] == sym[ps.dst])
@@ -58,14 +68,40 @@ def linear_candidates(
     keep = labels >= 0
     if keep.sum() < 2:
         return []
-    # Consecutive pairs i→j→k inside each (d, s) cluster, for all clusters at once.
-    n = sym.size
     idx, lab = sel[keep], labels[keep].astype(np.int64)
+    by_cluster = stable_argsort(lab)
+    bounds = np.concatenate([[0], np.cumsum(np.bincount(lab))])
+
+    def solve(part: tuple[int, int]) -> tuple[list[LinearCandidate], np.ndarray]:
+        take = np.sort(by_cluster[bounds[part[0]] : bounds[part[1]]])  # in the order of the pairs
+        return _part_candidates(ctx, sym, ps, prox, idx[take], lab[take], ledger)
+
+    solved = parallel.pmap(solve, _runs(np.diff(bounds).tolist(), _PART))
+    found = [c for part, _ in solved for c in part]
+    rank = np.concatenate([r for _, r in solved])
+    return [found[k] for k in rank_order(rank)]
+
+
+def _part_candidates(
+    ctx: Context,
+    sym: np.ndarray,
+    ps: PairSpace,
+    prox: np.ndarray,
+    idx: np.ndarray,
+    lab: np.ndarray,
+    ledger: Ledger | None,
+) -> tuple[list[LinearCandidate], np.ndarray]:
+    """The candidates of the (d, s) clusters ``lab`` of pairs ``idx``, and their step clusters' ranks."""
+    tol = ctx.tol
+    # Consecutive pairs i→j→k inside each (d, s) cluster, for all the part's clusters at once
+    # (pair indices and clusters in 32 bits: the part's largest arrays).
+    n = sym.size
     e1, e2 = successor_pairs(lab * n + ps.src[idx], lab * n + ps.dst[idx], np.arange(idx.size))
     if e1.size < 2:
-        return []
-    cluster = lab[e1]
-    e1, e2 = idx[e1], idx[e2]
+        return [], np.zeros(0, RANK)
+    cluster = lab.astype(np.int32)[e1]
+    narrow = idx.astype(np.int32) if len(ps) < 2**31 else idx
+    e1, e2 = narrow[e1], narrow[e2]
     ang = np.deg2rad(tol.angle)
     # The steps of α and β as (cos, sin) / ang, and the cluster: filled in place, column by
     # column (stacking five temporaries doubled this array's 77 MiB at 20,000 elements).
@@ -76,15 +112,19 @@ def linear_candidates(
         np.sin(step, out=emb2[:, col + 1])
     del step
     emb2[:, :4] /= ang
-    emb2[:, 4] = cluster * 1e7
-    lab2, _ = mean_shift(emb2)
+    np.multiply(cluster, 1e7, out=emb2[:, 4])
+    lab2, _, rank = ranked_mean_shift(emb2)
+    # The step clusters' members, label after label (increasing within each).
+    order = stable_argsort(lab2)
+    starts = np.searchsorted(lab2[order], np.arange(rank.size + 1))
+    wanted = np.diff(starts) >= 2  # a single consecutive pair is no sequence
     if ledger is not None:
-        lab2 = _promising(ledger, lab2, e1, e2, ps)
+        wanted &= _promising(ledger, order, starts, e1, e2, ps)
     problems: list[tuple[np.ndarray, np.ndarray, float, float]] = []
+    ranks: list[int] = []
     taken: dict[int, int] = {}
-    for g2 in group_indices(lab2):
-        if g2.size < 2:
-            continue  # a single consecutive pair is no sequence
+    for label in np.flatnonzero(wanted).tolist():
+        g2 = order[starts[label] : starts[label + 1]]
         c = int(cluster[g2[0]])
         taken[c] = taken.get(c, 0) + 1
         if taken[c] > _STEP_CLUSTERS:
@@ -94,68 +134,65 @@ def linear_candidates(
         if abs(dA) < tol.angle and abs(dB) < tol.angle:
             continue  # constant transform: a cluster C already covers it
         problems.append((e1[g2], e2[g2], dA, dB))
-    del emb2, lab2, e1, e2, cluster  # millions of consecutive pairs at 50,000 elements
-    batches = _batches([p[0].size for p in problems], parallel.jobs())
-    solved = parallel.pmap(lambda b: _linear_chains(ctx, sym, ps, problems[b[0] : b[1]], prox), batches)
-    return [c for part in solved for c in part]
+        ranks.append(label)
+    del emb2, lab2, order, e1, e2, cluster  # millions of consecutive pairs at 50,000 elements
+    sizes = [p[0].size for p in problems]
+    runs = _runs(sizes, _BATCH) if sum(sizes) >= _SPLIT else [(0, len(problems))]
+    solved = [c for lo, hi in runs for c in _linear_chains(ctx, sym, ps, problems[lo:hi], prox)]
+    found = [k for k, c in enumerate(solved) if c is not None]
+    return [c for c in solved if c is not None], rank[np.asarray(ranks, np.int64)[found]]
 
 
-def _batches(sizes: list[int], workers: int) -> list[tuple[int, int]]:
-    """Split problems of these sizes into runs, in order, each of ≤ a worker's share and ≤ :data:`_BATCH` pairs.
+def _runs(sizes: list[int], cap: int) -> list[tuple[int, int]]:
+    """Split items of these sizes into runs, in order, each of ≤ ``cap`` (a larger item is a run of its own).
 
-    The problems are independent (:func:`_linear_chains` solves each on its own keys), so the
-    runs can be solved on separate threads and their candidates concatenated in order: the
-    result does not depend on the number of workers or runs.  Runs are at most
-    :data:`_BATCH` pairs (a larger problem is a run of its own), so memory stays bounded
-    whatever the scene's size; small inputs stay in one run.
+    The items (clusters, step clusters) are independent problems, so the runs can be solved
+    on their own and their results concatenated in order; memory stays bounded whatever the
+    scene's size, and small inputs stay in one run.
     """
-    total = sum(sizes)
-    if total < _SPLIT or len(sizes) < 2:
-        return [(0, len(sizes))]
-    cap = min(_BATCH, -(-total // max(workers, 1)))
     runs, lo, acc = [], 0, 0
     for i, size in enumerate(sizes):
         if acc and acc + size > cap:
             runs.append((lo, i))
             lo, acc = i, 0
         acc += size
-    runs.append((lo, len(sizes)))
+    if sizes:
+        runs.append((lo, len(sizes)))
     return runs
 
 
 def _promising(
-    ledger: Ledger, labels: np.ndarray, e1: np.ndarray, e2: np.ndarray, ps: PairSpace
+    ledger: Ledger, order: np.ndarray, starts: np.ndarray, e1: np.ndarray, e2: np.ndarray, ps: PairSpace
 ) -> np.ndarray:
-    """``labels`` with the step clusters that cannot shorten the description set to -1.
+    """Per step cluster (members ``order[starts[k]:starts[k + 1]]``), whether it may shorten the description.
 
     A step cluster links pairs ``e1 → e2``; its chains use its distinct pairs and nodes, so
-    they number at least ``nodes - pairs``.
+    they number at least ``nodes - pairs``.  The clusters are counted in blocks of about
+    :data:`_BATCH` consecutive pairs (their temporaries are five times their size).
     """
-    n_lab = int(labels.max()) + 1 if labels.size else 0
-    ok = labels >= 0
-    lab = labels[ok]
-    m = len(ps)
-    pairs = sorted_unique(np.concatenate([lab * m + e1[ok], lab * m + e2[ok]])) // m
-    n = len(ledger.nodes)
-    nodes = (
-        sorted_unique(
-            np.concatenate([lab * n + ps.src[e1[ok]], lab * n + ps.dst[e1[ok]], lab * n + ps.dst[e2[ok]]])
-        )
-        // n
-    )
-    n_pairs = np.bincount(pairs, minlength=n_lab)
-    n_nodes = np.bincount(nodes, minlength=n_lab)
-    fam = np.zeros(n_lab, int)
-    fam[lab] = ledger.family[ps.src[e1[ok]]]
+    n_lab = starts.size - 1
+    m, n = np.int64(len(ps)), np.int64(len(ledger.nodes))
+    n_pairs = np.zeros(n_lab, np.int64)
+    n_nodes = np.zeros(n_lab, np.int64)
+    for lo, hi in _runs(np.diff(starts).tolist(), _BATCH):
+        members = order[starts[lo] : starts[hi]]
+        lab = np.repeat(np.arange(lo, hi, dtype=np.int64), np.diff(starts[lo : hi + 1]))
+        a, b = e1[members], e2[members]
+        pairs = sorted_unique(np.concatenate([lab * m + a, lab * m + b])) // m
+        n_pairs[lo:hi] = np.bincount(pairs - lo, minlength=hi - lo)
+        nodes = sorted_unique(np.concatenate([lab * n + ps.src[a], lab * n + ps.dst[a], lab * n + ps.dst[b]]))
+        n_nodes[lo:hi] = np.bincount(nodes // n - lo, minlength=hi - lo)
+    fam = ledger.family[ps.src[e1[order[starts[1:] - 1]]]]  # the last member's, as one assignment gives
     bound = ledger.bound(fam, n_nodes, np.full(n_lab, -1), np.zeros(n_lab), np.maximum(n_nodes - n_pairs, 1))
-    return np.where(ok & (bound[np.maximum(labels, 0)] > 0.0), labels, -1)
+    return bound > 0.0
 
 
-def _linear_chains(ctx, sym, ps, problems, prox) -> list[LinearCandidate]:
+def _linear_chains(ctx, sym, ps, problems, prox) -> list[LinearCandidate | None]:
     """One candidate per step cluster: its longest node-disjoint chains of one length and start.
 
     Every step cluster (links ``e1 → e2`` between consecutive pairs, steps ``dA``, ``dB``) is
     an independent problem; all are solved at once on keys offset by the problem's index.
+    Returns one entry per problem (None: no sequence).
     """
     if not problems:
         return []
@@ -164,7 +201,7 @@ def _linear_chains(ctx, sym, ps, problems, prox) -> list[LinearCandidate]:
     e1 = pid * n_pairs + np.concatenate([p[0] for p in problems])
     e2 = pid * n_pairs + np.concatenate([p[1] for p in problems])
     chains_e = edge_groups(e1, e2)
-    chains_e = chains_e.take(np.argsort(chains_e.firsts // n_pairs, kind="stable"))  # by problem
+    chains_e = chains_e.take(stable_argsort(chains_e.firsts // n_pairs))  # by problem
     prob = chains_e.firsts // n_pairs
     edges = chains_e.nodes % n_pairs
     k_e = chains_e.lengths
@@ -178,18 +215,16 @@ def _linear_chains(ctx, sym, ps, problems, prox) -> list[LinearCandidate]:
     nodes[~head] = ps.dst[edges] + base * n_nodes
     node_chains = Groups(nodes, offsets)
     # Node-disjoint chains only (greedy, longest first, per problem).
-    order = np.argsort(prob * (int(k_e.max()) + 1) - k_e, kind="stable")
+    order = stable_argsort(prob * (int(k_e.max()) + 1) - k_e)
     taken = greedy_disjoint(node_chains, order, int(n_nodes) * len(problems))
     acc = order[taken[order]]
     if acc.size == 0:
-        return []
+        return [None] * len(problems)
     step_tol = max(ctx.tol.angle, 1e-6)
     first_e = edges[chains_e.offsets[:-1][acc]]
-    key = np.column_stack(
+    first, inv, counts = row_groups(
         [prob[acc], k_e[acc], np.round(ps.alpha[first_e] / step_tol), np.round(ps.beta[first_e] / step_tol)]
     )
-    _, first, inv, counts = np.unique(key, axis=0, return_index=True, return_inverse=True, return_counts=True)
-    inv = inv.ravel()
     # Per problem, the most populated (length, start) group (the first such group on ties).
     kq, pq = k_e[acc][first], prob[acc][first]
     rank = np.lexsort((first, -kq, -counts * kq, pq))
@@ -198,10 +233,11 @@ def _linear_chains(ctx, sym, ps, problems, prox) -> list[LinearCandidate]:
     winning[win] = True
     best = acc[winning[inv]]  # the winners' chains, per problem in greedy order
     cuts = np.searchsorted(prob[best], np.arange(len(problems) + 1))
-    out = []
+    out: list[LinearCandidate | None] = []
     for p, (_, _, dA, dB) in enumerate(problems):
         chosen = best[cuts[p] : cuts[p + 1]]
         if chosen.size == 0 or (chosen.size < 2 and k_e[chosen[0]] < 2):
+            out.append(None)
             continue
         cand = _candidate(
             sym, ps, prox, chains_e.take(chosen), node_chains.take(chosen), n_pairs, n_nodes, dA, dB

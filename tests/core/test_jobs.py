@@ -101,34 +101,37 @@ def test_linear_sequences_taking_turns_give_the_same_rules(restore_jobs, monkeyp
     assert format_grammar(infer(grid).grammar) == beside
 
 
-def test_step_clusters_solved_in_batches_give_the_same_rules(restore_jobs, monkeypatch) -> None:
+def test_step_clusters_solved_in_parts_and_batches_give_the_same_rules(restore_jobs, monkeypatch) -> None:
     from lsys_core.hierarchy import linear
 
     grid = _rotating_grid(6, 9)
     parallel.set_jobs(1)
     whole = infer(grid)
     split = []
-    batches = linear._batches
-    monkeypatch.setattr(linear, "_SPLIT", 0)  # as a scene of millions of consecutive pairs does
-    monkeypatch.setattr(linear, "_batches", lambda *a: split.append(batches(*a)) or split[-1])
+    runs = linear._runs
+    # every (d, s) cluster a part of its own and every step cluster a run of its own, as a
+    # scene of millions of consecutive pairs has them, on three workers
+    monkeypatch.setattr(linear, "_PART", 1)
+    monkeypatch.setattr(linear, "_SPLIT", 0)
+    monkeypatch.setattr(linear, "_BATCH", 1)
+    monkeypatch.setattr(linear, "_runs", lambda *a: split.append(runs(*a)) or split[-1])
     parallel.set_jobs(3)
     parts = infer(grid)
-    assert max(len(b) for b in split) >= 2
+    assert max(len(r) for r in split) >= 2
     assert format_grammar(parts.grammar) == format_grammar(whole.grammar) and parts.log == whole.log
 
 
-def test_batches_cover_every_problem_once_in_order() -> None:
-    from lsys_core.hierarchy.linear import _BATCH, _batches
+def test_runs_cover_every_item_once_in_order() -> None:
+    from lsys_core.hierarchy.linear import _runs
 
-    assert _batches([5, 5], 1) == [(0, 2)]
+    assert _runs([], 10) == []
+    assert _runs([5, 5], 10) == [(0, 2)]
     for sizes in ([300_000] * 5, [1, 900_000, 1, 1], [400_000, 1], [700_000] * 9, [3_000_000, 10, 10]):
-        for workers in (1, 2, 3, 8):
-            runs = _batches(sizes, workers)
+        for cap in (1, 500_000, 10**9):
+            runs = _runs(sizes, cap)
             assert runs[0][0] == 0 and runs[-1][1] == len(sizes)
             assert all(a < b for a, b in runs) and all(x[1] == y[0] for x, y in itertools.pairwise(runs))
-            # no run holds more than the workers' share of the pairs, nor more than a bounded
-            # number (memory), unless it is a single problem
-            cap = min(-(-sum(sizes) // workers), _BATCH)
+            # no run holds more than the cap unless it is a single item
             assert all(sum(sizes[a:b]) <= cap or b - a == 1 for a, b in runs)
 
 

@@ -62,3 +62,54 @@ def test_support_of_seeds_that_stopped_is_that_of_a_new_query(seed: int) -> None
     fresh = np.bincount(owner, weights=weights[flat], minlength=len(seeds))
     assert kept.tobytes() == fresh.tobytes()
     assert (fresh[300:] > 100).all() and (fresh[:300] >= 1).all()
+
+
+def _separated_parts(seed: int) -> list[np.ndarray]:
+    """Point sets far apart along a last coordinate (as the consecutive pairs of several (d, s) clusters).
+
+    Each has lone points, dense clumps (more than ``_NEAR`` neighbours) and duplicates; one
+    part is a single point.
+    """
+    rng = np.random.default_rng(seed)
+    dim = int(rng.integers(1, 5))
+    parts = []
+    for k in range(int(rng.integers(2, 7))):
+        lone = rng.uniform(0, 30, (int(rng.integers(0, 60)), dim))
+        clumps = rng.uniform(0, 30, (int(rng.integers(1, 4)), dim))
+        dense = np.repeat(clumps, 3 * clustering._NEAR, axis=0)
+        dense += rng.normal(0, 0.3, dense.shape)
+        dup = np.repeat(rng.uniform(0, 30, (2, dim)), 3, axis=0)
+        pts = np.concatenate([lone, dense, dup])[rng.permutation(len(lone) + len(dense) + len(dup))]
+        if k == 3:
+            pts = pts[:1]
+        parts.append(np.column_stack([pts, np.full(len(pts), k * 1e7)]))
+    return parts
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_mean_shift_in_parts_is_the_mean_shift_of_the_whole(seed: int) -> None:
+    parts = _separated_parts(seed)
+    # the parts' points interleaved in the whole, each part keeping its order
+    owner = np.random.default_rng(seed).permutation(np.repeat(np.arange(len(parts)), [len(p) for p in parts]))
+    whole = np.empty((owner.size, parts[0].shape[1]))
+    for k, pts in enumerate(parts):
+        whole[owner == k] = pts
+    labels, modes, rank = clustering.ranked_mean_shift(whole)
+    assert clustering.rank_order(rank).tolist() == list(range(len(rank)))
+    assert labels.tolist() == clustering.mean_shift(whole)[0].tolist()
+    found = [clustering.ranked_mean_shift(pts) for pts in parts]
+    merged = clustering.rank_order(np.concatenate([r for _, _, r in found]))
+    # cluster k of the merged order is cluster k of the whole: same members, same mode, bit for bit
+    offsets = np.cumsum([0] + [len(r) for _, _, r in found])
+    part_modes = np.concatenate([m for _, m, _ in found])
+    lone, lone_whole = [], []
+    for k, g in enumerate(merged.tolist()):
+        p = int(np.searchsorted(offsets, g, side="right")) - 1
+        members = np.flatnonzero(owner == p)[found[p][0] == g - offsets[p]].tolist()
+        if rank["support"][k] < 0:  # a point alone: numbered by its index in its own part
+            lone += members
+            lone_whole += np.flatnonzero(labels == k).tolist()
+            continue
+        assert members == np.flatnonzero(labels == k).tolist()
+        assert part_modes[g].tobytes() == modes[k].tobytes()
+    assert sorted(lone) == sorted(lone_whole)
