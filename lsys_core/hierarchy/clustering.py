@@ -160,7 +160,7 @@ def _nearest_mode(pts: np.ndarray, modes: np.ndarray, cent: np.ndarray, inv: np.
     its points by their distance to that mode alone, a cell with none labels them -1; only the
     points of the other cells go through the KD-tree.  The labels are those of one KD-tree query
     of all points: of the 5·10^6 consecutive pairs of a 50,000-leaf grid, none needed the tree
-    (1.8 -> 0.3 s of CPU).
+    (1.8 -> 0.3 s of CPU).  A cell within ``1 - R_c`` of its one mode needs no distance per point.
     """
     if len(pts) <= _DIRECT:
         dist, idx = cKDTree(modes).query(pts, k=1)
@@ -172,8 +172,16 @@ def _nearest_mode(pts: np.ndarray, modes: np.ndarray, cent: np.ndarray, inv: np.
     tree = cKDTree(modes)
     near = tree.query_ball_point(cent, reach + (1.0 + 1e-9), return_sorted=False)
     only = np.fromiter((x[0] if len(x) == 1 else -len(x) for x in near), np.int64, len(near))
-    lab = np.full(len(pts), -1, np.int64)
+    # A cell whose points all lie well within a bandwidth of its one mode is labelled as a whole
+    # (the margin dwarfs rounding: each point's own test would say the same).
+    whole = np.full(len(cent), -1, np.int64)
+    one = np.flatnonzero(only >= 0)
+    all_in = one[_dist(cent[one], modes[only[one]]) + reach[one] <= 1.0 - 1e-9]
+    whole[all_in] = only[all_in]
+    only[all_in] = -1
+    lab = np.empty(len(pts), np.int64)
     for lo in range(0, len(pts), _BLOCK):
+        lab[lo : lo + _BLOCK] = whole[inv[lo : lo + _BLOCK]]
         m = only[inv[lo : lo + _BLOCK]]
         one = np.flatnonzero(m >= 0)
         inside = _dist(pts[lo + one], modes[m[one]]) <= 1.0

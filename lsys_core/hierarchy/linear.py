@@ -178,9 +178,11 @@ def _promising(
         members = order[starts[lo] : starts[hi]]
         lab = np.repeat(np.arange(lo, hi, dtype=np.int64), np.diff(starts[lo : hi + 1]))
         a, b = e1[members], e2[members]
-        pairs = sorted_unique(np.concatenate([lab * m + a, lab * m + b])) // m
-        n_pairs[lo:hi] = np.bincount(pairs - lo, minlength=hi - lo)
-        nodes = sorted_unique(np.concatenate([lab * n + ps.src[a], lab * n + ps.dst[a], lab * n + ps.dst[b]]))
+        keys = sorted_unique(np.concatenate([lab * m + a, lab * m + b]))
+        lab, pair = np.divmod(keys, m)
+        n_pairs[lo:hi] = np.bincount(lab - lo, minlength=hi - lo)
+        # the nodes of its pairs (i→j→k: the j of one is the source of the next)
+        nodes = sorted_unique(np.concatenate([lab * n + ps.src[pair], lab * n + ps.dst[pair]]))
         n_nodes[lo:hi] = np.bincount(nodes // n - lo, minlength=hi - lo)
     fam = ledger.family[ps.src[e1[order[starts[1:] - 1]]]]  # the last member's, as one assignment gives
     bound = ledger.bound(fam, n_nodes, np.full(n_lab, -1), np.zeros(n_lab), np.maximum(n_nodes - n_pairs, 1))
