@@ -22,6 +22,11 @@ from lsys_core.instancing.model import Instancing
 
 __all__ = ["ring_headings", "unwrap_symmetric", "unwrap_turns"]
 
+#: Radians within which an instance is taken to be exactly half a period from its parent: both
+#: equivalent rotations are as close, and the instance keeps the one nearest its own reported
+#: rotation (a tick beside an axis line at 90° to it stays as upright as the other ticks).
+TIE = 1e-9
+
 
 def unwrap_turns(a: np.ndarray, b: np.ndarray, period: float) -> np.ndarray:
     """Return the rotations (radians) of one group's instances, unwrapped along an MST."""
@@ -45,7 +50,14 @@ def unwrap_turns(a: np.ndarray, b: np.ndarray, period: float) -> np.ndarray:
         order, parent = breadth_first_order(tree, root, directed=False, return_predecessors=True)
         for node in order[1:]:
             p = out[parent[node]]
-            out[node] = p + np.mod(theta[node] - p + period / 2, period) - period / 2
+            turn = np.mod(theta[node] - p + period / 2, period) - period / 2
+            if abs(abs(turn) - period / 2) < TIE:  # half a period from the parent: keep its own side
+                turn = (
+                    period / 2
+                    if abs(p + period / 2 - theta[node]) <= abs(p - period / 2 - theta[node])
+                    else -period / 2
+                )
+            out[node] = p + turn
     return out
 
 
