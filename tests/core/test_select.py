@@ -93,6 +93,24 @@ def test_a_candidate_that_saves_far_fewer_bits_yields_to_one_on_its_nodes():
     # saving 4 times as much and 32 bits more: a candidate worth 20 bits keeps its place
     worth = _candidate([0, 4], 1.0, 0, gain=20.0)
     assert choose([worth, modest], Weights(), 6, lambda c: c, ceiling)[0] is worth
-    # a candidate that saves 32 bits or more is not a weak one: importance decides
+    # a candidate that saves more than a quarter of what its rivals save: importance decides
     paying = _candidate([0, 1], 1.0, 0, gain=40.0)
     assert choose([paying, rings], Weights(), 6, lambda c: c, ceiling) == [paying]
+
+
+def test_a_candidate_yields_to_rivals_that_together_save_far_more():
+    # a row of 13 ticks (nodes 0-12) and one of 12 grid lines (nodes 13-24); a branching of a
+    # line, its neighbour and the tick below, three times, is the most important but saves far
+    # less than the two rows it would cut (neither alone saves four times as much)
+    ticks = _candidate(list(range(13)), 0.5, 1, gain=167.0)
+    lines = _candidate(list(range(13, 25)), 0.5, 2, gain=133.0)
+    branching = _candidate([13, 14, 0, 16, 17, 3, 19, 20, 6], 1.0, 0, gain=51.0)
+
+    def ceiling(c: Candidate) -> float:
+        return c.gain
+
+    got = choose([branching, ticks, lines], Weights(), 25, lambda c: c, ceiling)
+    assert got[0] is ticks
+    # rivals that each save no more than the candidate do not add up against it
+    small = [_candidate([13 + 3 * k, 14 + 3 * k], 0.5, 3 + k, gain=50.0) for k in range(3)]
+    assert choose([branching, *small], Weights(), 25, lambda c: c, ceiling)[0] is branching
