@@ -79,20 +79,31 @@ def worthwhile(
     each application's first node, must put every node within its slack (what is left of the
     tolerance once its shapes and earlier rules have used their part).  Where that bound is
     too coarse for single elements (hand-drawn copies: shape and pose noise add up on paper,
-    not on the page), ``measure`` tells how far the derived element really is.
+    not on the page), ``measure`` tells how far the derived element really is.  The plainer
+    variant (:func:`~lsys_core.hierarchy.snap.plainer`) is taken first when it fits; between
+    exact copies (which stray from ``c`` and from their shape by less than rounding at the
+    user's precision may, :data:`~lsys_core.hierarchy.snap.SHARE` of the tolerance) only when
+    it moves no node more than ``snap`` of the tolerance farther than ``c`` does: exact copies
+    100 along and 1 across keep their 1, however much tolerance is left.
     """
     if ledger.ceiling(c) <= 0.0:
         return None  # whatever its numbers, it cannot pay (most candidates: rounding them costs more)
     c = snapped(c, nodes, limit, snap)
     if not _invertible(c):
         return None  # a transform that collapses its copies to a point places nothing
-    for variant in (plainer(c), c):  # a transform without its small turn and scale, if it fits
-        if variant is None:
-            continue
-        accepted = _admitted(variant, ledger, nodes, sizes, period, measure, n_terminals, limit)
+    plain = plainer(c)  # a transform without its small turn and scale, if it fits
+    if plain is not None:
+        cap = None
+        if np.isfinite(limit) and snap <= SHARE:  # at the user's precision, not symmetrizing
+            idx, err, _, _ = placement_error(c, nodes, sizes, period)
+            owner = c.groups.owner()
+            noise = np.zeros(len(c.groups))  # how far copies stray from the measured rule, or in shape
+            np.maximum.at(noise, owner, np.maximum(err, limit - nodes.slack[idx]))
+            cap = np.where(noise[owner] > SHARE * limit, np.inf, err + snap * limit)
+        accepted = _admitted(plain, ledger, nodes, sizes, period, measure, n_terminals, limit, cap)
         if accepted is not None:
             return accepted
-    return None
+    return _admitted(c, ledger, nodes, sizes, period, measure, n_terminals, limit)
 
 
 def _admitted(
@@ -104,8 +115,13 @@ def _admitted(
     measure: Measure | None,
     n_terminals: int,
     limit: float,
+    cap: np.ndarray | None = None,
 ) -> Candidate | None:
     """``c`` with its slack, starts and gain set, if it places its nodes within their slack and pays.
+
+    With ``cap``, every node must also lie within its entry of ``cap`` (node by node, in the
+    order of ``c``'s groups) of where it is, and later rules may move it only within what the
+    cap leaves.
 
     A sequence or pair whose best start differs from its first node's scale by rounding only
     (what :data:`~lsys_core.hierarchy.snap.SHARE` of the tolerance allows at its reach) starts
@@ -123,21 +139,23 @@ def _admitted(
             if single.all():
                 elements = np.array([int(nodes.members[i][0]) for i in idx[over]])
                 left[over] = limit - measure(elements, pa[over], pb[over])
-        return left, starts
+        if cap is not None:  # what the cap leaves is also all later rules may spend
+            left = np.minimum(left, cap - err)
+        return left, starts, not (left < 0.0).any()
 
     gain = ledger.gain(c)  # it does not depend on the fit: most candidates fail here, before fitting
     if gain <= 0.0:
         return None
-    left, starts = fit(0.0)
-    if starts is not None and not (left < 0.0).any() and np.isfinite(limit):
+    left, starts, fits = fit(0.0)
+    if starts is not None and fits and np.isfinite(limit):
         own = np.abs(nodes.a[c.groups.firsts])
         off = np.abs(np.abs(starts[0]) - own) / np.maximum(own, 1e-300)
         snap = SHARE * limit / max(float(group_reach(nodes, c.groups).max()), 1e-12)
         if ((off > 0.0) & (off <= snap)).any():
-            plain, plain_starts = fit(snap)
-            if not (plain < 0.0).any():
+            plain, plain_starts, plain_fits = fit(snap)
+            if plain_fits:
                 left, starts = plain, plain_starts
-    if (left < 0.0).any():
+    if not fits:
         return None
     owner = c.groups.owner()
     slack = np.full(len(c.groups), np.inf)
