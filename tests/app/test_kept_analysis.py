@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 import lsys_core.pipeline as pipeline
+import lsys_core.pipeline.analysis as analysis
 from app import jobs
 from lsys_core.cancel import CancelToken
 from lsys_core.grammar import format_grammar
@@ -20,13 +21,13 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "resources" / "examples"
 def counted(monkeypatch):
     """Count the similarity analyses run (the expensive first stage of ``analyse``)."""
     calls = []
-    real = pipeline._instancing
+    real = analysis._instancing
 
     def spy(*args, **kwargs):
         calls.append(1)
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(pipeline, "_instancing", spy)
+    monkeypatch.setattr(analysis, "_instancing", spy)
     monkeypatch.setattr(jobs, "_KEPT", [])
     return calls
 
