@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from lsys_core.hierarchy.candidates import BranchCandidate, Candidate, PairCandidate, SeqCandidate
+from lsys_core.hierarchy.flat import sorted_unique
 from lsys_core.hierarchy.gain import Ledger, group_reach, placement_error
 from lsys_core.hierarchy.nodes import Nodes
 from lsys_core.hierarchy.snap import SHARE, plainer, snapped
@@ -272,13 +273,19 @@ DOMINANT_BITS = 32.0
 
 
 def node_index(cands: list[Candidate], n_nodes: int) -> tuple[np.ndarray, np.ndarray]:
-    """The candidates on every node: ``owners[start[k]:start[k + 1]]`` are those on node ``k``."""
-    nodes = [np.unique(c.nodes()) for c in cands]
-    flat = np.concatenate(nodes) if nodes else np.zeros(0, int)
-    which = np.repeat(np.arange(len(cands)), [x.size for x in nodes])
-    order = np.argsort(flat, kind="stable")
-    start = np.searchsorted(flat[order], np.arange(n_nodes + 1))
-    return which[order], start
+    """The candidates on every node: ``owners[start[k]:start[k + 1]]`` are those on node ``k``.
+
+    Each node's candidates are listed once, in increasing order: one sort of the (node,
+    candidate) pairs packed into one integer (a ``np.unique`` per candidate took 0.5 s of a
+    50,052-leaf grid).
+    """
+    if not cands:
+        return np.zeros(0, np.int64), np.zeros(n_nodes + 1, np.int64)
+    nodes = [c.nodes() for c in cands]
+    flat = np.concatenate(nodes).astype(np.int64)
+    which = np.repeat(np.arange(len(cands), dtype=np.int64), [x.size for x in nodes])
+    node, owner = np.divmod(sorted_unique(flat * len(cands) + which), len(cands))
+    return owner, np.searchsorted(node, np.arange(n_nodes + 1))
 
 
 def _dominant(

@@ -114,3 +114,24 @@ def test_a_candidate_yields_to_rivals_that_together_save_far_more():
     # rivals that each save no more than the candidate do not add up against it
     small = [_candidate([13 + 3 * k, 14 + 3 * k], 0.5, 3 + k, gain=50.0) for k in range(3)]
     assert choose([branching, *small], Weights(), 25, lambda c: c, ceiling)[0] is branching
+
+
+def test_node_index_lists_each_nodes_candidates_once_in_order() -> None:
+    from lsys_core.hierarchy.select import node_index
+
+    class Cand:
+        def __init__(self, nodes: np.ndarray) -> None:
+            self._nodes = nodes
+
+        def nodes(self) -> np.ndarray:
+            return self._nodes
+
+    rng = np.random.default_rng(3)
+    cands = [Cand(rng.integers(0, 40, rng.integers(1, 12))) for _ in range(300)]  # repeats within one
+    owners, start = node_index(cands, 45)
+    for k in range(45):
+        want = [i for i, c in enumerate(cands) if k in c.nodes()]
+        assert owners[start[k] : start[k + 1]].tolist() == want
+    assert start[-1] == owners.size
+    empty_owners, empty_start = node_index([], 3)
+    assert empty_owners.size == 0 and empty_start.tolist() == [0, 0, 0, 0]
