@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lsys_core.hierarchy.flat import Groups, follow_links, greedy_links, isin, sorted_unique
-from lsys_core.hierarchy.sorting import first_occurrences, stable_argsort
+from lsys_core.hierarchy.flat import Groups, follow_links, greedy_links, isin
+from lsys_core.sorting import first_occurrences, sorted_unique, stable_argsort
 
 __all__ = ["Linked", "chains", "edge_chains", "edge_groups", "follow", "link_clusters", "successor_pairs"]
 

@@ -14,8 +14,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from lsys_core import parallel
-from lsys_core.hierarchy.flat import sorted_unique
-from lsys_core.hierarchy.sorting import stable_argsort
+from lsys_core.sorting import sorted_unique, stable_argsort
 
 __all__ = ["RANK", "group_indices", "mean_shift", "rank_order", "ranked_mean_shift"]
 

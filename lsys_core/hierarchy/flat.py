@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lsys_core.sorting import sorted_unique
+
 __all__ = [
     "Groups",
     "as_groups",
@@ -24,24 +26,12 @@ __all__ = [
     "greedy_links",
     "greedy_sets",
     "isin",
-    "sorted_unique",
 ]
 
 
 def as_groups(groups: Groups | Iterable[Iterable[int]]) -> Groups:
     """``groups`` as :class:`Groups` (made with :meth:`Groups.of` unless it is one already)."""
     return groups if isinstance(groups, Groups) else Groups.of(groups)
-
-
-def sorted_unique(x: np.ndarray) -> np.ndarray:
-    """``np.unique(x)`` for 1-D arrays, by sorting (numpy's hashing variant is far slower on integers)."""
-    s = np.sort(np.asarray(x).ravel())
-    if s.size < 2:
-        return s
-    keep = np.empty(s.size, bool)
-    keep[0] = True
-    np.not_equal(s[1:], s[:-1], out=keep[1:])
-    return s[keep]
 
 
 def isin(x: np.ndarray, ref: np.ndarray) -> np.ndarray:

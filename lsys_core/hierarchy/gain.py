@@ -25,7 +25,7 @@ from lsys_core.hierarchy.candidates import (
 )
 from lsys_core.hierarchy.describe import rule_bits, structured_bits, symbol_bits
 from lsys_core.hierarchy.emit import counters, rule_cases
-from lsys_core.hierarchy.flat import Groups, as_groups, sorted_unique
+from lsys_core.hierarchy.flat import Groups, as_groups
 from lsys_core.hierarchy.mdl import (
     KIND_BITS,
     Precision,
@@ -38,6 +38,7 @@ from lsys_core.hierarchy.mdl import (
 )
 from lsys_core.hierarchy.nodes import Nodes
 from lsys_core.hierarchy.symbols import SymbolTable
+from lsys_core.sorting import sorted_unique
 
 __all__ = ["Ledger", "cluster_bounds", "group_reach", "placement_error"]
 

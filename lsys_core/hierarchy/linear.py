@@ -15,10 +15,10 @@ from lsys_core.geometry.transforms import wrap_deg
 from lsys_core.hierarchy.candidates import Context, LinearCandidate
 from lsys_core.hierarchy.chains import edge_groups, successor_pairs
 from lsys_core.hierarchy.clustering import RANK, mean_shift, rank_order, ranked_mean_shift
-from lsys_core.hierarchy.flat import Groups, greedy_disjoint, sorted_unique
+from lsys_core.hierarchy.flat import Groups, greedy_disjoint
 from lsys_core.hierarchy.gain import Ledger, cluster_bounds
-from lsys_core.hierarchy.sorting import row_groups, stable_argsort
 from lsys_core.hierarchy.spaces import PairSpace
+from lsys_core.sorting import row_groups, sorted_unique, stable_argsort
 
 __all__ = ["linear_candidates"]
 

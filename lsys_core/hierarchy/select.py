@@ -15,11 +15,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from lsys_core.hierarchy.candidates import BranchCandidate, Candidate, PairCandidate, SeqCandidate
-from lsys_core.hierarchy.flat import sorted_unique
 from lsys_core.hierarchy.gain import Ledger, group_reach, placement_error
 from lsys_core.hierarchy.nodes import Nodes
 from lsys_core.hierarchy.snap import SHARE, plainer, snapped
 from lsys_core.settings import setting
+from lsys_core.sorting import sorted_unique
 
 __all__ = [
     "WEAK_COVER",

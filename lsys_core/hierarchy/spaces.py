@@ -14,8 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from lsys_core.hierarchy.flat import sorted_unique
 from lsys_core.parallel import jobs
+from lsys_core.sorting import sorted_unique
 
 __all__ = ["PairSpace", "pair_space"]
 

@@ -34,6 +34,7 @@ from lsys_core.geometry.stretch import stretch_cubics
 from lsys_core.grammar.model import Terminal
 from lsys_core.instancing.deviation import pose_deviations
 from lsys_core.instancing.model import Instancing
+from lsys_core.sorting import row_groups, stable_argsort
 from lsys_core.svg.model import Element, Scene
 
 __all__ = ["stretch_families"]
@@ -75,22 +76,8 @@ def _short(x: float, tol: float) -> float:
 
 def _runs(labels: np.ndarray) -> list[np.ndarray]:
     """Positions of equal labels, one array per label in ascending order of the labels, each ascending."""
-    order = np.argsort(labels, kind="stable")
+    order = stable_argsort(labels)
     return np.split(order, np.flatnonzero(np.diff(labels[order])) + 1) if order.size else []
-
-
-def _row_labels(key: np.ndarray) -> np.ndarray:
-    """Label rows of ``key`` (m, c) by their order: ``np.unique(key, axis=0, return_inverse=True)[1]``.
-
-    One lexicographic sort of the columns (sorting rows as records took 12 times as long).
-    """
-    order = np.lexsort(key.T[::-1])
-    rows = key[order]
-    new = np.ones(order.size, bool)
-    new[1:] = np.any(rows[1:] != rows[:-1], axis=1)
-    labels = np.empty(order.size, np.int64)
-    labels[order] = np.cumsum(new) - 1
-    return labels
 
 
 def _families(scene: Scene, free: np.ndarray, tol: float) -> list[tuple[complex, np.ndarray]]:
@@ -120,7 +107,7 @@ def _families(scene: Scene, free: np.ndarray, tol: float) -> list[tuple[complex,
             idx = avail[run]
             cubics = np.stack([np.asarray(elements[i].cubics, complex).reshape(-1, 4) for i in idx]) * axis
             key, length, _ = _profiles(cubics, tol)
-            for sel in _runs(_row_labels(key)):
+            for sel in _runs(row_groups(list(key.T))[1]):
                 sel = sel[length[sel] > _FLAT * tol]  # a flat shape has no halves to pull apart
                 members, lengths = idx[sel], length[sel]
                 if members.size >= 2 and np.ptp(lengths) > tol:

@@ -29,11 +29,7 @@ from lsys_core.instancing.model import Instancing, terminal_shapes
 from lsys_core.instancing.orientation import ring_headings, unwrap_symmetric
 from lsys_core.instancing.roundness import merge_round, round_within
 from lsys_core.instancing.stretch import stretch_families
-from lsys_core.report import (
-    as_instancing,
-    bounds,
-    element_circles,
-)
+from lsys_core.report import as_instancing, bounds, element_circles
 from lsys_core.settings import InferenceSettings
 from lsys_core.svg.model import Scene
 

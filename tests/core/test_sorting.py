@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lsys_core.hierarchy.sorting import first_occurrences, row_groups, stable_argsort
+from lsys_core.sorting import first_occurrences, row_groups, stable_argsort
 
 
 def _ints(seed: int) -> np.ndarray:

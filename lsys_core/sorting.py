@@ -1,4 +1,4 @@
-"""Stable orders of integer arrays by one plain sort, and groups of equal rows.
+"""Distinct values, stable orders and groups of equal rows of integer arrays, by plain sorts.
 
 numpy sorts integers with SIMD code, but its stable ``argsort`` of int64 is a merge sort,
 and ``np.unique`` of integers (numpy ≥ 2.3) hashes them: on this project's machines, for
@@ -13,9 +13,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from lsys_core.hierarchy.flat import sorted_unique
+__all__ = ["first_occurrences", "row_groups", "sorted_unique", "stable_argsort"]
 
-__all__ = ["first_occurrences", "row_groups", "stable_argsort"]
+
+def sorted_unique(x: np.ndarray) -> np.ndarray:
+    """``np.unique(x)`` for 1-D arrays, by sorting (numpy's hashing variant is far slower on integers)."""
+    s = np.sort(np.asarray(x).ravel())
+    if s.size < 2:
+        return s
+    keep = np.empty(s.size, bool)
+    keep[0] = True
+    np.not_equal(s[1:], s[:-1], out=keep[1:])
+    return s[keep]
 
 
 def stable_argsort(x: np.ndarray) -> np.ndarray:
