@@ -27,7 +27,7 @@ from lsys_core.hierarchy.candidates import (
     space_key,
 )
 from lsys_core.hierarchy.chains import link_clusters
-from lsys_core.hierarchy.clustering import group_indices, mean_shift
+from lsys_core.hierarchy.clustering import group_indices, mean_shift, spread
 from lsys_core.hierarchy.gain import Ledger, cluster_bounds
 from lsys_core.hierarchy.linear import linear_candidates
 from lsys_core.hierarchy.spaces import PairSpace
@@ -97,7 +97,7 @@ def find_candidates(
     found: list[ConstantCluster] = []
     pending: list[tuple[int, ConstantCluster]] = []
     clusters = [idx for idx in group_indices(labels) if idx.size >= 2]  # a single pair repeats nothing
-    costs = [np.linalg.norm(emb[idx, :5] - emb[idx, :5].mean(0), axis=1) for idx in clusters]
+    costs = spread(emb[:, :5], clusters)
     for idx, linked in zip(clusters, link_clusters(clusters, costs, ps.src, ps.dst, n_nodes), strict=True):
         si, sj = int(sym[ps.src[idx[0]]]), int(sym[ps.dst[idx[0]]])
         chain_list, used = linked.chains, linked.used

@@ -39,7 +39,7 @@ class Linked:
 
 
 def link_clusters(
-    clusters: list[np.ndarray], costs: list[np.ndarray], src: np.ndarray, dst: np.ndarray, n_nodes: int
+    clusters: list[np.ndarray], costs: np.ndarray, src: np.ndarray, dst: np.ndarray, n_nodes: int
 ) -> list[Linked]:
     """Link every cluster's pairs into sequences, all clusters at once.
 
@@ -50,8 +50,8 @@ def link_clusters(
     ----------
     clusters : list of ndarray of int
         The pair indices of every cluster, increasing.
-    costs : list of ndarray of float
-        The cost of every pair of every cluster.
+    costs : ndarray of float
+        The cost of every pair, cluster after cluster (as ``np.concatenate(clusters)``).
     src, dst : ndarray of int
         First and second node of every pair.
     n_nodes : int
@@ -63,7 +63,7 @@ def link_clusters(
     n = np.int64(max(n_nodes, 1))
     items = np.concatenate(clusters)
     cid = np.repeat(np.arange(count, dtype=np.int64), [c.size for c in clusters])
-    order = np.lexsort((np.concatenate(costs), cid))  # per cluster by cost; ties in pair order
+    order = np.lexsort((costs, cid))  # per cluster by cost; ties in pair order
     s_key = cid * n + src[items]
     d_key = cid * n + dst[items]
     both = np.concatenate([s_key, d_key])
@@ -106,7 +106,7 @@ def chains(src: np.ndarray, dst: np.ndarray, cost: np.ndarray) -> tuple[list[lis
     if src.size == 0:
         return [], {}
     n = int(max(src.max(), dst.max())) + 1
-    (linked,) = link_clusters([np.arange(src.size)], [np.asarray(cost, float)], src, dst, n)
+    (linked,) = link_clusters([np.arange(src.size)], np.asarray(cost, float), src, dst, n)
     return linked.chains.tolist(), dict(zip(linked.src.tolist(), linked.dst.tolist(), strict=True))
 
 

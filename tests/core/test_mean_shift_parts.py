@@ -113,3 +113,16 @@ def test_mean_shift_in_parts_is_the_mean_shift_of_the_whole(seed: int) -> None:
         assert members == np.flatnonzero(labels == k).tolist()
         assert part_modes[g].tobytes() == modes[k].tobytes()
     assert sorted(lone) == sorted(lone_whole)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_spread_is_each_groups_distance_from_its_mean_bit_for_bit(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    pts = rng.normal(size=(30_000, 6)) * rng.uniform(0.1, 1e4, 6)  # magnitudes where order matters
+    sizes = [2, 9, 17, 3_000, *rng.integers(2, 60, 200).tolist()]
+    members = np.sort(rng.choice(len(pts), sum(sizes), replace=False))
+    groups = np.split(members, np.cumsum(sizes)[:-1])
+    want = np.concatenate([np.linalg.norm(pts[g, :5] - pts[g, :5].mean(0), axis=1) for g in groups])
+    got = clustering.spread(pts[:, :5], groups)
+    assert got.tobytes() == want.tobytes()
+    assert clustering.spread(pts, []).size == 0
