@@ -138,7 +138,13 @@ def _part_candidates(
     del emb2, lab2, order, e1, e2, cluster  # millions of consecutive pairs at 50,000 elements
     sizes = [p[0].size for p in problems]
     runs = _runs(sizes, _BATCH) if sum(sizes) >= _SPLIT else [(0, len(problems))]
-    solved = [c for lo, hi in runs for c in _linear_chains(ctx, sym, ps, problems[lo:hi], prox)]
+    solved = [
+        c
+        for part in parallel.pmap(
+            lambda run: _linear_chains(ctx, sym, ps, problems[run[0] : run[1]], prox), runs
+        )
+        for c in part
+    ]
     found = [k for k, c in enumerate(solved) if c is not None]
     return [c for c in solved if c is not None], rank[np.asarray(ranks, np.int64)[found]]
 
@@ -172,18 +178,22 @@ def _promising(
     """
     n_lab = starts.size - 1
     m, n = np.int64(len(ps)), np.int64(len(ledger.nodes))
-    n_pairs = np.zeros(n_lab, np.int64)
-    n_nodes = np.zeros(n_lab, np.int64)
-    for lo, hi in _runs(np.diff(starts).tolist(), _BATCH):
+
+    def count(run: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+        lo, hi = run
         members = order[starts[lo] : starts[hi]]
         lab = np.repeat(np.arange(lo, hi, dtype=np.int64), np.diff(starts[lo : hi + 1]))
         a, b = e1[members], e2[members]
         keys = sorted_unique(np.concatenate([lab * m + a, lab * m + b]))
         lab, pair = np.divmod(keys, m)
-        n_pairs[lo:hi] = np.bincount(lab - lo, minlength=hi - lo)
+        n_pairs = np.bincount(lab - lo, minlength=hi - lo)
         # the nodes of its pairs (i→j→k: the j of one is the source of the next)
         nodes = sorted_unique(np.concatenate([lab * n + ps.src[pair], lab * n + ps.dst[pair]]))
-        n_nodes[lo:hi] = np.bincount(nodes // n - lo, minlength=hi - lo)
+        return n_pairs, np.bincount(nodes // n - lo, minlength=hi - lo)
+
+    counted = parallel.pmap(count, _runs(np.diff(starts).tolist(), _BATCH))
+    n_pairs = np.concatenate([c[0] for c in counted]) if counted else np.zeros(0, np.int64)
+    n_nodes = np.concatenate([c[1] for c in counted]) if counted else np.zeros(0, np.int64)
     fam = ledger.family[ps.src[e1[order[starts[1:] - 1]]]]  # the last member's, as one assignment gives
     bound = ledger.bound(fam, n_nodes, np.full(n_lab, -1), np.zeros(n_lab), np.maximum(n_nodes - n_pairs, 1))
     return bound > 0.0
