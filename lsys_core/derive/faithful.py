@@ -136,7 +136,12 @@ def _clear_nearest(
 
 
 def _greedy(target: np.ndarray, found: np.ndarray, ids: np.ndarray) -> np.ndarray:
-    """Match points ``found`` to ``target`` one to one, nearest pairs first (ids of the targets)."""
+    """Match points ``found`` to ``target`` one to one, nearest pairs first (ids of the targets).
+
+    The pairs of every point and its 8 nearest targets are taken in order of distance; the
+    loop ends when every point has one (50,052 derived leaves: 0.27-0.57 -> 0.17-0.33 s).
+    A vectorised greedy (:func:`lsys_core.hierarchy.flat.greedy_links`) took 0.53-0.70 s.
+    """
     from scipy.spatial import cKDTree
 
     k = min(8, target.size)
@@ -144,14 +149,16 @@ def _greedy(target: np.ndarray, found: np.ndarray, ids: np.ndarray) -> np.ndarra
         np.column_stack([found.real, found.imag]), k=k
     )
     dist, near = dist.reshape(found.size, k), near.reshape(found.size, k)
-    order = np.argsort(dist, axis=None, kind="stable")
+    rows, cols = np.divmod(np.argsort(dist, axis=None, kind="stable"), k)
     result = np.full(found.size, -1, np.int64)
     taken = np.zeros(target.size, bool)
-    for flat in order.tolist():
-        i, j = divmod(flat, k)
-        t = near[i, j]
+    left = found.size  # once every point has its target, the rest of the pairs change nothing
+    for i, t in zip(rows.tolist(), near[rows, cols].tolist(), strict=True):
         if result[i] < 0 and not taken[t]:
             result[i], taken[t] = t, True
+            left -= 1
+            if not left:
+                break
     rest = np.flatnonzero(result < 0)
     result[rest] = np.flatnonzero(~taken)[: rest.size]
     return ids[result]

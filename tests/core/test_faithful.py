@@ -339,3 +339,32 @@ def test_matching_from_the_nearest_instances_is_the_whole_matrix_matching() -> N
             want = _assignment(cost, scale)
             assert [x.tolist() for x in found] == [x.tolist() for x in want]
     assert shortcuts >= 4  # the shortcut is taken where the match is clear
+
+
+@pytest.mark.parametrize("case", ["jitter", "ties", "exact", "few"])
+def test_greedy_matching_takes_the_nearest_pairs_first(case: str) -> None:
+    """The greedy matching of many instances: every pair of a point and one of its 8 nearest
+    targets, in order of distance (ties in order of point, then neighbour rank), as the plain loop takes them."""
+    from scipy.spatial import cKDTree
+
+    from lsys_core.derive.faithful import _greedy
+
+    rng = np.random.default_rng(len(case))
+    n = 5 if case == "few" else 3_000
+    target = rng.uniform(0, 100, n) + 1j * rng.uniform(0, 100, n)
+    if case == "ties":
+        target = np.round(target / 10) * 10  # many points at one place: equal distances
+    found = target[rng.permutation(n)] + (0 if case == "exact" else rng.normal(0, 2, n) * (1 + 1j))
+    ids = np.arange(n) + 7
+    k = min(8, n)
+    dist, near = cKDTree(np.column_stack([target.real, target.imag])).query(
+        np.column_stack([found.real, found.imag]), k=k
+    )
+    want = np.full(n, -1)
+    taken = np.zeros(n, bool)
+    for flat in np.argsort(dist, axis=None, kind="stable").tolist():
+        i, j = divmod(flat, k)
+        if want[i] < 0 and not taken[near[i, j]]:
+            want[i], taken[near[i, j]] = near[i, j], True
+    want[want < 0] = np.flatnonzero(~taken)[: int((want < 0).sum())]
+    assert np.array_equal(_greedy(target, found, ids), ids[want])
