@@ -11,14 +11,17 @@ for it from several stages (seven parses of a 10^6-line path took 14 s of a 35 s
 
 from __future__ import annotations
 
+import re
 import threading
 from collections import OrderedDict
+from collections.abc import Sequence
 
 import numpy as np
 
-from lsys_core.geometry.paths import cubics_from_d
+from lsys_core.geometry.pathdata import parse_paths
+from lsys_core.geometry.paths import arrays_from_table, cubics_from_d
 
-__all__ = ["CACHE_SEGMENTS", "shape_arrays"]
+__all__ = ["CACHE_SEGMENTS", "shape_arrays", "shapes_arrays"]
 
 #: Segments kept in the cache at most (about 72 bytes each); a larger shape has a slot of its own.
 CACHE_SEGMENTS = 250_000
@@ -29,6 +32,8 @@ _cache: OrderedDict[str, _Arrays] = OrderedDict()
 _held = 0  # segments in the cache
 _large: tuple[str, _Arrays] | None = None  # the last shape too large for the cache
 _lock = threading.Lock()  # the editor renders while a worker thread infers
+#: A character that is not part of absolute ``M``/``L``/``C``/``Z`` path data.
+_NOT_ABSOLUTE = re.compile(r"[^MLCZ0-9eE.+\-,\s]")
 
 
 def shape_arrays(d: str) -> _Arrays:
@@ -52,7 +57,20 @@ def shape_arrays(d: str) -> _Arrays:
     SvgError
         If the path data cannot be parsed (not cached: every call raises again).
     """
-    global _held, _large
+    hit = _cached(d)
+    if hit is not None:
+        return hit
+    if d.strip():
+        cubics, subpaths, closed = cubics_from_d(d)
+    else:
+        cubics, subpaths, closed = np.zeros((0, 4), complex), np.zeros(0, np.intp), ()
+    cubics.setflags(write=False)
+    subpaths.setflags(write=False)
+    return _keep(d, (cubics, subpaths, closed))
+
+
+def _cached(d: str) -> _Arrays | None:
+    """The arrays of ``d`` if they are cached (the cache's most recent entry from now on)."""
     with _lock:
         hit = _cache.get(d)
         if hit is not None:
@@ -60,14 +78,13 @@ def shape_arrays(d: str) -> _Arrays:
             return hit
         if _large is not None and _large[0] == d:
             return _large[1]
-    if d.strip():
-        cubics, subpaths, closed = cubics_from_d(d)
-    else:
-        cubics, subpaths, closed = np.zeros((0, 4), complex), np.zeros(0, np.intp), ()
-    cubics.setflags(write=False)
-    subpaths.setflags(write=False)
-    arrays = (cubics, subpaths, closed)
-    k = len(cubics)
+    return None
+
+
+def _keep(d: str, arrays: _Arrays) -> _Arrays:
+    """Put the read-only arrays of ``d`` into the cache (or the large slot) and return them."""
+    global _held, _large
+    k = len(arrays[0])
     if k > CACHE_SEGMENTS:
         with _lock:
             _large = (d, arrays)
@@ -80,3 +97,51 @@ def shape_arrays(d: str) -> _Arrays:
                 _, old = _cache.popitem(last=False)
                 _held -= len(old[0])
     return arrays
+
+
+def shapes_arrays(ds: Sequence[str]) -> list[_Arrays | None]:
+    """Return the cubic arrays of many path data texts, parsing the new absolute ones in one pass.
+
+    Parameters
+    ----------
+    ds : sequence of str
+        SVG path data texts.
+
+    Returns
+    -------
+    list
+        Per text, what :func:`shape_arrays` returns for it, or None where it raises
+        (unreadable path data).
+    """
+    out: list[_Arrays | None] = [None] * len(ds)
+    batch: dict[str, list[int]] = {}
+    for i, d in enumerate(ds):
+        hit = _cached(d)
+        if hit is not None:
+            out[i] = hit
+        elif d.strip() and _NOT_ABSOLUTE.search(d) is None:
+            batch.setdefault(d, []).append(i)
+        else:
+            out[i] = _one(d)
+    if batch:
+        texts = list(batch)
+        table = parse_paths(texts)
+        for d, error, path in zip(texts, table.errors, arrays_from_table(table, len(texts)), strict=True):
+            if error is not None:
+                arrays = _one(d)  # raises the reader's error, or reads what the pass refused
+            else:
+                # copies: a cached shape owns its memory, not a view of the whole pass's array
+                cubics, subpaths = path.cubics.copy(), path.subpaths.copy()
+                cubics.setflags(write=False)
+                subpaths.setflags(write=False)
+                arrays = _keep(d, (cubics, subpaths, path.closed))
+            for i in batch[d]:
+                out[i] = arrays
+    return out
+
+
+def _one(d: str) -> _Arrays | None:
+    try:
+        return shape_arrays(d)
+    except Exception:  # unreadable path data (as primitive() and compact_path_data() treat it)
+        return None

@@ -26,7 +26,7 @@ import numpy as np
 from lsys_core.geometry.bezier import sample_cubics
 from lsys_core.geometry.shapes import shape_arrays
 
-__all__ = ["TOLERANCE", "primitive"]
+__all__ = ["TOLERANCE", "primitive", "primitive_of"]
 
 #: Largest distance, relative to the shape's size, between the path and the element written for it.
 TOLERANCE = 1e-3
@@ -91,6 +91,11 @@ def primitive(d: str) -> tuple[str, dict[str, str]] | None:
         cubics, _, closed = shape_arrays(d)
     except Exception:  # unreadable path data stays path data
         return None
+    return primitive_of(cubics, closed)
+
+
+def primitive_of(cubics: np.ndarray, closed: tuple[bool, ...]) -> tuple[str, dict[str, str]] | None:
+    """:func:`primitive` of a path given as its cubic arrays (``cubics`` and ``closed`` per subpath)."""
     if cubics.shape[0] == 0 or len(closed) != 1 or not np.isfinite(cubics).all():
         return None
     size = float(np.ptp(cubics.real) + np.ptp(cubics.imag))
