@@ -26,7 +26,7 @@ import numpy as np
 from lsys_core.geometry.shapes import shapes_arrays
 from lsys_core.render.primitives import TOLERANCE, primitive_of
 
-__all__ = ["primitives"]
+__all__ = ["Shape", "primitives"]
 
 #: Relative distance from a threshold below which a bulk-computed quantity decides nothing.
 _MARGIN = 1e-7
@@ -36,10 +36,11 @@ _SAMPLES = 8
 #: largest, for the fit to be trusted to reject.
 _GAP = 1e-6
 
-_Shape = tuple[str, dict[str, str]]
+#: A basic element: its tag and attributes.
+Shape = tuple[str, dict[str, str]]
 
 
-def primitives(ds: Sequence[str]) -> list[_Shape | None]:
+def primitives(ds: Sequence[str]) -> list[Shape | None]:
     """Return :func:`~lsys_core.render.primitives.primitive` of every path data text.
 
     Parameters
@@ -53,7 +54,7 @@ def primitives(ds: Sequence[str]) -> list[_Shape | None]:
         Per text, ``(tag, attributes)`` or None, exactly as ``primitive(d)`` returns it.
     """
     arrays = shapes_arrays(ds)
-    out: list[_Shape | None] = [None] * len(ds)
+    out: list[Shape | None] = [None] * len(ds)
     cand = [
         i for i, a in enumerate(arrays) if a is not None and a[0].shape[0] > 0 and len(a[2]) == 1
     ]  # the others have no single subpath: None

@@ -41,8 +41,8 @@ import numpy as np
 
 from lsys_core.derive.model import Calls, Drawing
 from lsys_core.derive.paint import css_decls, css_text
-from lsys_core.render.compact import compact_path_data as _compact
-from lsys_core.render.primitives_many import primitives
+from lsys_core.render.compact import compact_paths as _compact_paths
+from lsys_core.render.primitives_many import Shape, primitives
 from lsys_core.render.svg import DIGITS, _attr, _baked_path, _canvas, _length, check_finite
 
 __all__ = ["drawing_to_structured_svg"]
@@ -175,7 +175,7 @@ def _stroked(decls: dict[str, str]) -> dict[str, str]:
     return decls
 
 
-def _unturned_circles(shapes: list, symbol: np.ndarray, a: np.ndarray) -> np.ndarray:
+def _unturned_circles(shapes: list[Shape | None], symbol: np.ndarray, a: np.ndarray) -> np.ndarray:
     """The poses ``a`` with the turns of circles about their own centre taken out (they do not show).
 
     An inferred ring of round dots turns each dot as it goes round; written as a ``<circle>``
@@ -206,6 +206,7 @@ def _uses(drawing, shapes, a_all, symbol, style, styles, scale, plain, ids: _Ids
     key = np.zeros(n, np.intp)
     pieces: list[tuple[str, str, tuple[float, ...]]] = []
     defs: list[str] = []
+    chosen: list[tuple[str, Shape | None, str, dict[str, str]]] = []  # path, shape, id, common style
     decls = [_stroked(css_decls(s)) for s in styles]
     order = np.flatnonzero(plain)
     if order.size == 0:
@@ -241,11 +242,16 @@ def _uses(drawing, shapes, a_all, symbol, style, styles, scale, plain, ids: _Ids
         term = drawing.terminals[t]
         ref = ids.get(term.name)
         path_only = turn or any(k in d for d in finals for k in _PATH_ONLY)
-        defs.append(_definition(term.path, None if path_only else shapes[t], ref, common))
+        shape = None if path_only else shapes[t]
+        if shape is not None and "transform" in shape[1]:
+            shape = None  # a turned rectangle or ellipse: a path (see the module docstring)
+        chosen.append((term.path, shape, ref, common))
         for d in finals:
             rest = {k: v for k, v in d.items() if k not in common}
             template, lengths = _template(rest, varying=not same)
             pieces.append((ref, template, lengths))
+    paths = iter(_compact_paths([c[0] for c in chosen if c[1] is None]))
+    defs = [_definition(next(paths) if shape is None else "", shape, ref, common) for _, shape, ref, common in chosen]
     return _Uses(key, pieces), defs
 
 
@@ -275,13 +281,11 @@ def _template(decls: dict[str, str], varying: bool) -> tuple[str, tuple[float, .
     return f' style="{_attr(css_text(out)).replace("%", "%%").replace(chr(0), _NUM)}"', tuple(flat)
 
 
-def _definition(path: str, shape, ref: str, common: dict[str, str]) -> str:
-    """Return a terminal's element for ``<defs>``: its basic ``shape`` (or None) or its path."""
+def _definition(path: str, shape: Shape | None, ref: str, common: dict[str, str]) -> str:
+    """Return a terminal's element for ``<defs>``: its basic ``shape``, or else its (compacted) path."""
     style = f' style="{_attr(css_text(common))}"' if common else ""
-    if shape is not None and "transform" in shape[1]:
-        shape = None  # a turned rectangle or ellipse: a path (see the module docstring)
     if shape is None:
-        return f'<path id="{_attr(ref)}" d="{_attr(_compact(path))}"{style}/>\n'
+        return f'<path id="{_attr(ref)}" d="{_attr(path)}"{style}/>\n'
     tag, attrs = shape
     # position attributes are 0 by default
     text = " ".join(

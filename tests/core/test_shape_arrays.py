@@ -63,3 +63,29 @@ def test_the_last_large_shape_is_parsed_once(monkeypatch: pytest.MonkeyPatch) ->
     shape_arrays(other)  # takes the slot: one large shape is held, not every one
     assert shape_arrays(big) is not first and parsed == [big, other, big]
     assert shapes._held == 0
+
+
+def test_many_texts_parse_as_each_alone(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Absolute texts are parsed in one pass, the others one by one: the arrays are the same, bit for bit."""
+    monkeypatch.setattr(shapes, "_cache", type(shapes._cache)())
+    monkeypatch.setattr(shapes, "_held", 0)
+    rng = np.random.default_rng(2)
+    ds = []
+    for _ in range(300):
+        pts = rng.normal(0, 10 ** rng.uniform(-3, 6), (7, 2))
+        d = f"M{pts[0, 0]:.17g} {pts[0, 1]:.17g} L{pts[1, 0]:.9g},{pts[1, 1]:.9g}"
+        d += " C" + " ".join(f"{v:.9g}" for v in pts[2:5].ravel()) + (" Z" if rng.random() < 0.5 else "")
+        d += f" M{pts[5, 0]:.17g} {pts[5, 1]:.17g} L{pts[6, 0]:.17g} {pts[6, 1]:.17g}Z" if rng.random() < 0.3 else ""
+        ds.append(d)
+    ds += ["", " ", "M0 0 Lx", "m0.1 0.2 l1 1 h3z", "M1 1 L2 2 M3 3 L 4 4Z", "M1e3 2E-2L3 4", ds[0]]
+    got = shapes.shapes_arrays(ds)
+    for d, arrays in zip(ds, got, strict=True):
+        if d == "M0 0 Lx":
+            assert arrays is None
+            continue
+        expected = cubics_from_d(d) if d.strip() else (np.zeros((0, 4), complex), np.zeros(0, np.intp), ())
+        assert arrays is not None and arrays[2] == expected[2]
+        assert arrays[0].view(np.uint64).tolist() == expected[0].view(np.uint64).tolist()
+        np.testing.assert_array_equal(arrays[1], expected[1])
+        assert not arrays[0].flags.writeable and arrays[0].base is None  # owns its memory
+        assert shape_arrays(d) is arrays  # cached
