@@ -98,7 +98,9 @@ def compact_paths(ds: list[str], block: int = 1 << 20) -> list[str]:
                 hi += 1
             # NUL is no part of a number: the texts come apart where they were joined
             chunk = members[lo:hi]
-            for i, text in zip(chunk, _rounded("\0".join(ds[i] for i in chunk), decimals).split("\0"), strict=True):
+            for i, text in zip(
+                chunk, _rounded("\0".join(ds[i] for i in chunk), decimals).split("\0"), strict=True
+            ):
                 out[i] = text
             lo = hi
     return out

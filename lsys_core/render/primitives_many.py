@@ -32,6 +32,8 @@ __all__ = ["Shape", "primitives"]
 _MARGIN = 1e-7
 #: Samples per segment (as the full test's ellipse fit).
 _SAMPLES = 8
+#: Segments tested at once (bounds the temporaries, some 200 bytes a segment).
+_BLOCK = 1 << 14
 #: Smallest gap between the two smallest singular values of a conic fit, relative to the
 #: largest, for the fit to be trusted to reject.
 _GAP = 1e-6
@@ -55,28 +57,39 @@ def primitives(ds: Sequence[str]) -> list[Shape | None]:
     """
     arrays = shapes_arrays(ds)
     out: list[Shape | None] = [None] * len(ds)
-    cand = [
-        i for i, a in enumerate(arrays) if a is not None and a[0].shape[0] > 0 and len(a[2]) == 1
-    ]  # the others have no single subpath: None
+    cand: list[int] = []  # the paths of one subpath (the others are none of the shapes)
+    parts: list[np.ndarray] = []
+    flags: list[bool] = []
+    for i, found in enumerate(arrays):
+        if found is not None and found[0].shape[0] > 0 and len(found[2]) == 1:
+            cand.append(i)
+            parts.append(found[0])
+            flags.append(found[2][0])
     if not cand:
         return out
-    parts = [arrays[i][0] for i in cand]  # type: ignore[index]
     counts = np.fromiter((c.shape[0] for c in parts), np.intp, len(parts))
     cubics = np.concatenate(parts)
     starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    closed = np.array(flags, dtype=bool)
     finite = np.logical_and.reduceat(np.isfinite(cubics).all(axis=1), starts)
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
         size = _ptp_at(cubics.real, starts) + _ptp_at(cubics.imag, starts)
         tol = TOLERANCE * size
-        closed = np.array([arrays[i][2][0] for i in cand], bool)  # type: ignore[index]
         keep = finite & (size > 0)
-        straight, unsure = _straight_bounds(cubics, np.repeat(tol, counts))
+        seg_tol = np.repeat(tol, counts)
+        tests = [
+            _straight_bounds(cubics[lo : lo + _BLOCK], seg_tol[lo : lo + _BLOCK])
+            for lo in range(0, len(cubics), _BLOCK)
+        ]
+        straight, unsure = (np.concatenate(t) for t in zip(*tests, strict=True))
         n_straight = np.add.reduceat(straight.astype(np.intp), starts)
         n_unsure = np.add.reduceat(unsure.astype(np.intp), starts)
     sure = n_unsure == 0
     # a line: one open segment, straight; a rectangle: four or more straight sides (a rounded
     # one: four straight sides and curved corners); otherwise an ellipse: no straight side
-    keep &= np.where(closed, ~sure | (n_straight >= 4) | (n_straight == 0), (counts == 1) & ~(sure & (n_straight == 0)))
+    keep &= np.where(
+        closed, ~sure | (n_straight >= 4) | (n_straight == 0), (counts == 1) & ~(sure & (n_straight == 0))
+    )
     oval = np.flatnonzero(keep & closed & sure & (n_straight == 0))
     with np.errstate(invalid="ignore", over="ignore", divide="ignore", under="ignore"):
         keep[oval] = ~_surely_no_ellipse(cubics, starts[oval], counts[oval], tol[oval])
@@ -92,7 +105,9 @@ def _ptp_at(values: np.ndarray, starts: np.ndarray) -> np.ndarray:
     return np.maximum.reduceat(values.max(axis=1), starts) - np.minimum.reduceat(values.min(axis=1), starts)
 
 
-def _straight_bounds(cubics: np.ndarray, tol: np.ndarray, max_angle: float = 1e-3) -> tuple[np.ndarray, np.ndarray]:
+def _straight_bounds(
+    cubics: np.ndarray, tol: np.ndarray, max_angle: float = 1e-3
+) -> tuple[np.ndarray, np.ndarray]:
     """The straightness test of :func:`~lsys_core.render.primitives._straight` with its doubt.
 
     Returns ``(straight, unsure)``: what the test says, and where a condition is so close to
@@ -120,7 +135,9 @@ def _straight_bounds(cubics: np.ndarray, tol: np.ndarray, max_angle: float = 1e-
     return straight, unsure
 
 
-def _surely_no_ellipse(cubics: np.ndarray, starts: np.ndarray, counts: np.ndarray, tol: np.ndarray) -> np.ndarray:
+def _surely_no_ellipse(
+    cubics: np.ndarray, starts: np.ndarray, counts: np.ndarray, tol: np.ndarray
+) -> np.ndarray:
     """Whether each path (all segments curved, one closed subpath) is certainly no ellipse.
 
     The full test's conic fit and radii, for the paths of each segment count at once; a path
@@ -132,16 +149,27 @@ def _surely_no_ellipse(cubics: np.ndarray, starts: np.ndarray, counts: np.ndarra
     s = 1.0 - t
     weights = [s * s * s, 3.0 * s * s * t, 3.0 * s * t * t, t * t * t]
     for k in np.unique(counts).tolist():
-        sel = np.flatnonzero(counts == k)
-        rows = (starts[sel][:, None] + np.arange(k)[None, :]).reshape(-1)
-        c = cubics[rows].reshape(sel.size, k, 4)
-        pts = weights[0] * c[:, :, 0:1]
-        for j in (1, 2, 3):
-            pts = pts + weights[j] * c[:, :, j : j + 1]
-        pts = pts.reshape(sel.size, -1)
-        span = np.maximum(np.ptp(pts.real, axis=1), np.ptp(pts.imag, axis=1))
-        ok = np.isfinite(pts).all(axis=1) & (span > 0)  # the others are left to the full test
-        out[sel[ok]] = _no_ellipse(pts[ok], tol[sel[ok]])
+        group = np.flatnonzero(counts == k)
+        step = max(1, _BLOCK // (_SAMPLES * k))
+        for lo in range(0, group.size, step):
+            sel = group[lo : lo + step]
+            out[sel] = _no_ellipse_rows(cubics, starts[sel], k, tol[sel], weights)
+    return out
+
+
+def _no_ellipse_rows(
+    cubics: np.ndarray, starts: np.ndarray, k: int, tol: np.ndarray, weights: list[np.ndarray]
+) -> np.ndarray:
+    """:func:`_surely_no_ellipse` of paths of ``k`` segments each, sampled as the full test samples."""
+    out = np.zeros(starts.size, bool)
+    c = cubics[(starts[:, None] + np.arange(k)[None, :]).reshape(-1)].reshape(starts.size, k, 4)
+    pts = weights[0] * c[:, :, 0:1]
+    for j in (1, 2, 3):
+        pts = pts + weights[j] * c[:, :, j : j + 1]
+    pts = pts.reshape(starts.size, -1)
+    span = np.maximum(np.ptp(pts.real, axis=1), np.ptp(pts.imag, axis=1))
+    ok = np.isfinite(pts).all(axis=1) & (span > 0)  # the others are left to the full test
+    out[ok] = _no_ellipse(pts[ok], tol[ok])
     return out
 
 

@@ -215,9 +215,9 @@ def _uses(drawing, shapes, a_all, symbol, style, styles, scale, plain, ids: _Ids
     sym = symbol[order]
     starts = np.flatnonzero(np.r_[True, sym[1:] != sym[:-1]])
     factor = scale[order]
-    constant = (np.maximum.reduceat(factor, starts) - np.minimum.reduceat(factor, starts)) <= 1e-12 * np.maximum(
-        1.0, np.maximum.reduceat(np.abs(factor), starts)
-    )
+    constant = (
+        np.maximum.reduceat(factor, starts) - np.minimum.reduceat(factor, starts)
+    ) <= 1e-12 * np.maximum(1.0, np.maximum.reduceat(np.abs(factor), starts))
     a = a_all[order]
     turned = np.logical_or.reduceat((np.abs(a.imag) > 1e-9 * np.abs(a)) | (a.real < 0), starts)
     # (terminal, style) pairs in order: the pieces, numbered as they are made below
@@ -251,7 +251,10 @@ def _uses(drawing, shapes, a_all, symbol, style, styles, scale, plain, ids: _Ids
             template, lengths = _template(rest, varying=not same)
             pieces.append((ref, template, lengths))
     paths = iter(_compact_paths([c[0] for c in chosen if c[1] is None]))
-    defs = [_definition(next(paths) if shape is None else "", shape, ref, common) for _, shape, ref, common in chosen]
+    defs = [
+        _definition(next(paths) if shape is None else "", shape, ref, common)
+        for _, shape, ref, common in chosen
+    ]
     return _Uses(key, pieces), defs
 
 

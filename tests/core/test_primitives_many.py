@@ -27,7 +27,9 @@ def _ellipse(rng, n_arcs: int, noise: float, round_: bool) -> str:
     p0, p3 = unit[:-1], unit[1:]
     rows = np.stack([p0, p0 + 1j * k * p0, p3 - 1j * k * p3, p3], axis=1)
     cubics = (rows.real * rx + 1j * rows.imag * ry) * turn + centre
-    cubics = cubics + noise * 2 * (rx + ry) * (rng.normal(size=cubics.shape) + 1j * rng.normal(size=cubics.shape))
+    cubics = cubics + noise * 2 * (rx + ry) * (
+        rng.normal(size=cubics.shape) + 1j * rng.normal(size=cubics.shape)
+    )
     cubics[1:, 0] = cubics[:-1, 3]
     cubics[-1, 3] = cubics[0, 0]
     return d_from_cubics(cubics, None, (True,))
@@ -90,8 +92,9 @@ def _full(d: str):
     return primitive_of(cubics, closed)
 
 
-@pytest.mark.parametrize("seed", [0, 1, 2])
-def test_bulk_answers_are_the_full_tests(monkeypatch: pytest.MonkeyPatch, seed: int) -> None:
+@pytest.mark.parametrize("seed,block", [(0, 1 << 14), (1, 1 << 14), (2, 7)])
+def test_bulk_answers_are_the_full_tests(monkeypatch: pytest.MonkeyPatch, seed: int, block: int) -> None:
+    monkeypatch.setattr(primitives_many, "_BLOCK", block)  # 7: many blocks, paths across their ends
     ds = _cases(seed)
     expected = [_full(d) for d in ds]
     monkeypatch.setattr(shapes, "_cache", OrderedDict())  # parse anew, in one pass

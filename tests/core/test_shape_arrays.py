@@ -75,7 +75,11 @@ def test_many_texts_parse_as_each_alone(monkeypatch: pytest.MonkeyPatch) -> None
         pts = rng.normal(0, 10 ** rng.uniform(-3, 6), (7, 2))
         d = f"M{pts[0, 0]:.17g} {pts[0, 1]:.17g} L{pts[1, 0]:.9g},{pts[1, 1]:.9g}"
         d += " C" + " ".join(f"{v:.9g}" for v in pts[2:5].ravel()) + (" Z" if rng.random() < 0.5 else "")
-        d += f" M{pts[5, 0]:.17g} {pts[5, 1]:.17g} L{pts[6, 0]:.17g} {pts[6, 1]:.17g}Z" if rng.random() < 0.3 else ""
+        d += (
+            f" M{pts[5, 0]:.17g} {pts[5, 1]:.17g} L{pts[6, 0]:.17g} {pts[6, 1]:.17g}Z"
+            if rng.random() < 0.3
+            else ""
+        )
         ds.append(d)
     ds += ["", " ", "M0 0 Lx", "m0.1 0.2 l1 1 h3z", "M1 1 L2 2 M3 3 L 4 4Z", "M1e3 2E-2L3 4", ds[0]]
     got = shapes.shapes_arrays(ds)
