@@ -21,8 +21,11 @@ import numpy as np
 from lsys_core.geometry.pathdata import parse_paths
 from lsys_core.geometry.paths import arrays_from_table, cubics_from_d
 
-__all__ = ["CACHE_SEGMENTS", "shape_arrays", "shapes_arrays"]
+__all__ = ["CACHE_SEGMENTS", "PASS_CHARS", "shape_arrays", "shapes_arrays"]
 
+#: Characters of path data parsed in one pass by :func:`shapes_arrays` (the lexer's temporaries
+#: are some 30 bytes a character: 1.2 MB of texts in one pass peaked at 40 MiB).
+PASS_CHARS = 1 << 16
 #: Segments kept in the cache at most (about 72 bytes each); a larger shape has a slot of its own.
 CACHE_SEGMENTS = 250_000
 
@@ -123,21 +126,32 @@ def shapes_arrays(ds: Sequence[str]) -> list[_Arrays | None]:
             batch.setdefault(d, []).append(i)
         else:
             out[i] = _one(d)
-    if batch:
-        texts = list(batch)
-        table = parse_paths(texts)
-        for d, error, path in zip(texts, table.errors, arrays_from_table(table, len(texts)), strict=True):
-            if error is not None:
-                arrays = _one(d)  # raises the reader's error, or reads what the pass refused
-            else:
-                # copies: a cached shape owns its memory, not a view of the whole pass's array
-                cubics, subpaths = path.cubics.copy(), path.subpaths.copy()
-                cubics.setflags(write=False)
-                subpaths.setflags(write=False)
-                arrays = _keep(d, (cubics, subpaths, path.closed))
-            for i in batch[d]:
-                out[i] = arrays
+    texts = list(batch)
+    lo = 0
+    while lo < len(texts):
+        hi, length = lo, 0
+        while hi < len(texts) and (hi == lo or length + len(texts[hi]) <= PASS_CHARS):
+            length += len(texts[hi]) + 1
+            hi += 1
+        _parse_pass(texts[lo:hi], batch, out)
+        lo = hi
     return out
+
+
+def _parse_pass(texts: list[str], where: dict[str, list[int]], out: list[_Arrays | None]) -> None:
+    """Parse absolute texts together; put each one's arrays at its places ``where[d]`` in ``out``."""
+    table = parse_paths(texts)
+    for d, error, path in zip(texts, table.errors, arrays_from_table(table, len(texts)), strict=True):
+        if error is not None:
+            arrays = _one(d)  # raises the reader's error, or reads what the pass refused
+        else:
+            # copies: a cached shape owns its memory, not a view of the whole pass's array
+            cubics, subpaths = path.cubics.copy(), path.subpaths.copy()
+            cubics.setflags(write=False)
+            subpaths.setflags(write=False)
+            arrays = _keep(d, (cubics, subpaths, path.closed))
+        for i in where[d]:
+            out[i] = arrays
 
 
 def _one(d: str) -> _Arrays | None:
