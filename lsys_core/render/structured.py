@@ -29,7 +29,10 @@ A designer who opens the file sees what repeats:
 If the paint order interleaves the instances of two calls, a call's group is written in parts
 (the later parts with ids ``P1-1.2``, ``P1-1.3``, …), so the picture stays exact.
 
-Numbers are formatted by one ``%`` operation over all instances, as in the flat export.
+Numbers are formatted by one ``%`` operation over all instances, as in the flat export, and the
+terminals' shapes are examined all at once (:func:`~lsys_core.render.primitives_many.primitives`,
+:func:`~lsys_core.render.compact.compact_paths`): 10,000 distinct leaves took 15 s one by one and
+take under a second so.
 """
 
 from __future__ import annotations
