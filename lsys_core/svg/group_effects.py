@@ -73,7 +73,7 @@ def apply(
         if isinstance(rec, ShapeRecord):
             if rec.hidden:
                 continue
-            st = rec.style
+            st = rec.style = dict(rec.style)  # (records may share one: :class:`.declare.DeclarationMemo`)
             if opacity < 1.0:
                 st["opacity"] = f"{unit_value(st.get('opacity'), 1.0) * opacity:.6g}"
             if clip is not None:

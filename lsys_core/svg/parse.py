@@ -220,11 +220,14 @@ def _elements(reader: Reader) -> tuple[list[Element], Counter]:
     cubics.flags.writeable = False
     lows, highs = starts.tolist(), (starts + counts).tolist()
     out = []
+    texts: dict[int, str] = {}  # records share declarations (the records hold them: ids stay unique)
     for i in np.flatnonzero(~(bad | flat)).tolist():
         r = recs[i]
         sub = r.path.subpaths
         sub.flags.writeable = False
-        style = ";".join(map(":".join, r.style.items()))  # name:value;...
+        style = texts.get(id(r.style))
+        if style is None:
+            style = texts[id(r.style)] = ";".join(map(":".join, r.style.items()))  # name:value;...
         out.append(Element(cubics[lows[i] : highs[i]], sub, r.path.closed, style, r.source, r.order))
     return out, skips
 

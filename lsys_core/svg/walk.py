@@ -36,6 +36,7 @@ from lsys_core.svg.records import (
     switch_child,
 )
 from lsys_core.svg.shapes import Geometry, KeepAsIs, draws_cap_dots, shape_geometry
+from lsys_core.svg.siblings import Run, same_run
 from lsys_core.svg.style import DEFAULT_FONT_SIZE, Cascade
 from lsys_core.svg.tree import Tree, describe, href_of, local_name, shown
 from lsys_core.svg.values import (
@@ -98,6 +99,8 @@ class Reader:
         self.root_font = DEFAULT_FONT_SIZE
         self._last_anisotropy: tuple[Matrix, float] | None = None
         self._facts = StyleFactsMemo()
+        self._run: Run | None = None
+        self._runs = not self.cascade.sheet.rules  # (see :mod:`.siblings`)
 
     # -- styles ---------------------------------------------------------------------------------
 
@@ -160,6 +163,7 @@ class Reader:
             return
         font = facts.font
         vp = ctx.vp if font == ctx.vp.font_size and font else ctx.vp._replace(font_size=font)
+        notes = len(self.notes)
         own = self._transform(el, style, vp)
         ctm = multiply(ctx.ctm, own) if own is not None else ctx.ctm
         # (made directly: ``dataclasses.replace`` cost 0.35 of 5.3 profiled seconds for 20,000 leaves)
@@ -175,7 +179,9 @@ class Reader:
             self.keep_as_is(el, ctx, "transform-origin: renderers differ")
             return
         if tag in SHAPES:
-            self.shape(el, tag, inner, ctx, facts)
+            run = Run(el, tag, inner, facts) if self._runs and len(self.notes) == notes else None
+            self._run = run
+            self.shape(el, tag, inner, ctx, facts, run)
             return
         start = len(self.records)
         clip = None
@@ -186,10 +192,7 @@ class Reader:
                 if entered is None:
                     return
                 body, clip = entered
-            children = switch_child(el) if tag == "switch" else list(el)
-            for child in children:
-                if isinstance(child.tag, str):
-                    self.walk(child, body)
+            self._children(switch_child(el) if tag == "switch" else list(el), body)
         elif tag == "use":
             self.use(el, inner)
         elif tag != "symbol":
@@ -197,6 +200,19 @@ class Reader:
             return
         if len(self.records) > start:
             group_effects.apply(self, el, style, inner, start, clip)
+
+    def _children(self, children: list[ET.Element], body: Ctx) -> None:
+        """Draw the children of a container in ``body``; like siblings share a :class:`.siblings.Run`."""
+        last: Run | None = None
+        for child in children:
+            if not isinstance(child.tag, str):
+                continue
+            if last is not None and same_run(last, child):
+                self.shape(child, last.tag, last.inner, body, last.facts, last)
+                continue
+            self._run = None
+            self.walk(child, body)
+            last = self._run if self._run is not None and self._run.el is child else None
 
     def _transform(self, el: ET.Element, style: dict[str, str], vp: Viewport) -> Matrix | None:
         """The element's own transform (CSS ``transform`` wins over the attribute), with its origin."""
@@ -283,9 +299,7 @@ class Reader:
             if rx or ry:
                 entered = replace(entered, ctm=multiply(entered.ctm, (1.0, 0.0, 0.0, 1.0, -rx, -ry)))
         start = len(self.records)
-        for child in target:
-            if isinstance(child.tag, str):
-                self.walk(child, entered)
+        self._children(list(target), entered)
         if len(self.records) > start:
             # The symbol's own opacity is not applied (as renderers draw it); its viewport clips.
             effects = {k: v for k, v in style.items() if k != "opacity"} if tag == "symbol" else style
@@ -293,8 +307,14 @@ class Reader:
 
     # -- shapes ---------------------------------------------------------------------------------
 
-    def shape(self, el: ET.Element, tag: str, ctx: Ctx, outer: Ctx, facts: StyleFacts) -> None:
-        """Record a drawable shape with what it draws with (``facts`` of its style), then its markers."""
+    def shape(
+        self, el: ET.Element, tag: str, ctx: Ctx, outer: Ctx, facts: StyleFacts, run: Run | None = None
+    ) -> None:
+        """Record a drawable shape with what it draws with (``facts`` of its style), then its markers.
+
+        ``run`` holds what its like siblings share (:mod:`.siblings`): declarations that depend
+        on the style and context only are worked out once for them.
+        """
         style = ctx.style
         wants_markers = tag in _MARKABLE and facts.markers
         try:
@@ -317,9 +337,13 @@ class Reader:
         if empty and not marks:
             self.skips[reason or "degenerate (zero size)"] += 1
             return
-        decls = self._declarations.get(self.resources, style, ctx, geom.path)
+        decls = run.decls if run is not None else None
         if decls is None:
-            return  # clipped out entirely
+            decls = self._declarations.get(self.resources, style, ctx, geom.path)
+            if decls is None:
+                return  # clipped out entirely
+            if run is not None and self._declarations.shared(style, ctx):
+                run.decls = decls
         stroked = decls.get("stroke", "none") != "none"
         if stroked and self._anisotropy(ctx.ctm) > 1.02:
             self.keep_as_is(el, outer, "stroke under a non-uniform scale")
