@@ -14,7 +14,7 @@ import xml.etree.ElementTree as ET
 from lsys_core.errors import LimitError
 from lsys_core.svg.tree import SVG_NS, Tree, href_of, local_name
 
-__all__ = ["check_expansion"]
+__all__ = ["check_expansion", "has_use"]
 
 #: Elements whose content is never drawn in place (only through a reference, or not at all).
 _NOT_IN_FLOW = frozenset(
@@ -31,7 +31,7 @@ def check_expansion(tree: Tree, max_elements: int, max_depth: int, name: str) ->
         More than ``max_elements`` elements, or nesting deeper than ``max_depth`` levels,
         once references are expanded.
     """
-    if not _has_use(tree.root):
+    if not has_use(tree.root):
         size, height = _tree_size(tree.root)
         if size <= max_elements and height <= max_depth:
             return size
@@ -73,7 +73,7 @@ def check_expansion(tree: Tree, max_elements: int, max_depth: int, name: str) ->
     return total.get(id(tree.root), 1)
 
 
-def _has_use(root: ET.Element) -> bool:
+def has_use(root: ET.Element) -> bool:
     """Whether the document has a ``<use>`` (found at the speed of ElementTree's own search)."""
     return any(next(root.iter(tag), None) is not None for tag in (SVG_NS + "use", "use"))
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 import zlib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pyexpat import XML_PARAM_ENTITY_PARSING_NEVER as _NO_PARAM_ENTITIES
 from pyexpat import ExpatError, ParserCreate, errors, expat_CAPI  # noqa: F401 (CAPI: C parser)
 
@@ -106,8 +106,6 @@ class _Reader:
         self.max_elements = max_elements
         self.max_depth = max_depth
         self.builder = ET.TreeBuilder()
-        self.depth = 0
-        self.count = 0
         self.expansion = 0
         self.entities = 0
         self.utf16 = data[:2] in (b"\xff\xfe", b"\xfe\xff")
@@ -125,20 +123,34 @@ class _Reader:
         """Expat's ``uri}local`` into ElementTree's ``{uri}local``."""
         return "{" + name if "}" in name else name
 
-    def start(self, tag: str, attrs: dict[str, str]) -> None:
-        self.count += 1
-        self.depth += 1
-        if self.count > self.max_elements:
-            raise LimitError(f"{self.name} has more than {self.max_elements:,} elements")
-        if self.depth > self.max_depth:
-            raise LimitError(f"{self.name}: elements are nested more than {self.max_depth} levels deep")
-        if "}" in "".join(attrs):  # attributes in a namespace (most have none: kept as expat made them)
-            attrs = {self.fix(k): v for k, v in attrs.items()}
-        self.builder.start("{" + tag if "}" in tag else tag, attrs)
+    def element_handlers(self) -> tuple[Callable[[str, dict[str, str]], None], Callable[[str], None]]:
+        """The start and end handlers of elements, counting and building the tree.
 
-    def end(self, tag: str) -> None:
-        self.depth -= 1
-        self.builder.end("{" + tag if "}" in tag else tag)
+        Closures over local state: expat calls them for every element, and looking up the
+        reader's attributes in them took 20 of the 160 ms of reading a 50,052-leaf grid.
+        """
+        start_element, end_element = self.builder.start, self.builder.end
+        max_elements, max_depth, name = self.max_elements, self.max_depth, self.name
+        count = depth = 0
+
+        def start(tag: str, attrs: dict[str, str]) -> None:
+            nonlocal count, depth
+            count += 1
+            depth += 1
+            if count > max_elements:
+                raise LimitError(f"{name} has more than {max_elements:,} elements")
+            if depth > max_depth:
+                raise LimitError(f"{name}: elements are nested more than {max_depth} levels deep")
+            if "}" in "".join(attrs):  # attributes in a namespace (most have none: kept as expat made them)
+                attrs = {self.fix(k): v for k, v in attrs.items()}
+            start_element("{" + tag if "}" in tag else tag, attrs)
+
+        def end(tag: str) -> None:
+            nonlocal depth
+            depth -= 1
+            end_element("{" + tag if "}" in tag else tag)
+
+        return start, end
 
     def entity(self, name, is_parameter, value, base, system_id, public_id, notation) -> None:
         if is_parameter:
@@ -176,8 +188,7 @@ def read_xml(data: bytes, name: str, max_elements: int, max_depth: int) -> ET.El
     p.buffer_text = True
     p.ordered_attributes = False
     p.SetParamEntityParsing(_NO_PARAM_ENTITIES)
-    p.StartElementHandler = r.start
-    p.EndElementHandler = r.end
+    p.StartElementHandler, p.EndElementHandler = r.element_handlers()
     p.CharacterDataHandler = r.builder.data
     p.EntityDeclHandler = r.entity
     p.UnparsedEntityDeclHandler = lambda *a: r.refuse("unparsed entities")

@@ -98,7 +98,7 @@ def test_expansion_without_use_counts_as_the_reference_walk(monkeypatch):
     tree = _tree(BODY)
     quick = uses.check_expansion(tree, 100, 100, "doc")
     assert quick == 6  # root, g, g, rect, x:thing, text (not the defs, the symbol, their content)
-    monkeypatch.setattr(uses, "_has_use", lambda root: True)
+    monkeypatch.setattr(uses, "has_use", lambda root: True)
     assert uses.check_expansion(tree, 100, 100, "doc") == quick
 
 
