@@ -13,7 +13,7 @@ from lsys_core.errors import LimitError
 from lsys_core.geometry import pathdata as pd
 from lsys_core.geometry.pathdata import PathTable, parse_paths
 from lsys_core.geometry.paths import ArrayPath, arrays_from_table
-from lsys_core.svg.tree import Tree, local_name
+from lsys_core.svg.tree import Tree
 
 __all__ = ["DEFAULT_MAX_PATH_NUMBERS", "DEFAULT_MAX_SEGMENTS", "PathCache"]
 
@@ -29,7 +29,7 @@ class PathCache:
     def __init__(self, tree: Tree, name: str = "<string>", max_segments: int | None = None) -> None:
         if max_segments is None:
             max_segments = DEFAULT_MAX_SEGMENTS
-        ds = list(dict.fromkeys(el.get("d") or "" for el in tree.root.iter() if local_name(el.tag) == "path"))
+        ds = list(dict.fromkeys([el.get("d") or "" for el in tree.of_kind("path")]))
         self._index = {d: i for i, d in enumerate(ds)}
         try:
             self._table = parse_paths(ds, max_numbers=DEFAULT_MAX_PATH_NUMBERS) if ds else None

@@ -56,8 +56,8 @@ class Run:
         What the walk reads from its style.
     decls : dict or None
         Its declarations, when they depend on its style and context only (set by the walk).
-    plain : bool
-        Whether it is a ``<path>`` drawn as one visible record with those declarations, without
+    plain : dict or None
+        Its declarations when it is a ``<path>`` drawn as one visible record with them, without
         markers or caps: a like sibling with path data draws the same way (set by the walk).
     """
 
@@ -69,7 +69,7 @@ class Run:
         self.inner = inner
         self.facts = facts
         self.decls: dict[str, str] | None = None
-        self.plain = False
+        self.plain: dict[str, str] | None = None
         self._get: Callable[[dict[str, str]], object] | None = None
         self._keys: KeysView[str] | None = None
         self._values: object = None

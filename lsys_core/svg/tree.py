@@ -112,6 +112,18 @@ class Tree:
         """Return the following sibling element, if any."""
         return self._linked()[2].get(id(el))
 
+    def of_kind(self, tag: str) -> list[ET.Element]:
+        """The elements whose SVG local name is ``tag``, in document order.
+
+        Found by ElementTree's own search (a few milliseconds for 50,000 elements, where asking
+        every element for its local name took 20), unless the document writes the tag both with
+        and without the SVG namespace.
+        """
+        svg, plain = list(self.root.iter(SVG_NS + tag)), list(self.root.iter(tag))
+        if svg and plain:
+            return [el for el in self.root.iter() if el.tag in (tag, SVG_NS + tag)]
+        return svg or plain
+
     @staticmethod
     def tag(el: ET.Element) -> str | None:
         """Return the SVG local name of an element."""

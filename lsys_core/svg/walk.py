@@ -82,9 +82,8 @@ class Reader:
 
     def __post_init__(self) -> None:
         sheet = StyleSheet()
-        for el in self.tree.root.iter():
-            if local_name(el.tag) == "style":  # whatever its type says, as renderers read it
-                sheet.add("".join(el.itertext()))
+        for el in self.tree.of_kind("style"):  # whatever its type says, as renderers read it
+            sheet.add("".join(el.itertext()))
         self.notes.extend(sheet.notes)
         self.cascade = Cascade(self.tree, sheet)
         self.paths = PathCache(self.tree, self.name)
@@ -204,30 +203,25 @@ class Reader:
     def _children(self, children: list[ET.Element], body: Ctx) -> None:
         """Draw the children of a container in ``body``; like siblings share a :class:`.siblings.Run`."""
         last: Run | None = None
+        path_of, names = self.paths.get, self._names
         for child in children:
             if not isinstance(child.tag, str):
                 continue
             if last is not None and same_run(last, child):
-                if not (last.plain and self._plain_path(child, last)):
-                    self.shape(child, last.tag, last.inner, body, last.facts, last)
+                # A plain path run draws each like sibling as its first path (:attr:`.siblings.Run.plain`).
+                if last.plain is not None:
+                    path = path_of(child.get("d") or "", False)[0]
+                    if path.cubics.shape[0]:  # else the full way says why it is skipped
+                        chain = last.inner.chain
+                        self._add_shape(
+                            path, last.inner.ctm, last.plain, chain + names.get(id(child), "path")
+                        )
+                        continue
+                self.shape(child, last.tag, last.inner, body, last.facts, last)
                 continue
             self._run = None
             self.walk(child, body)
             last = self._run if self._run is not None and self._run.el is child else None
-
-    def _plain_path(self, el: ET.Element, run: Run) -> bool:
-        """Record a ``<path>`` like a plain one before it (:attr:`.siblings.Run.plain`); False: not drawn so.
-
-        What :meth:`shape` does for it, without the questions its run has answered: one in
-        three of the walk's microseconds for a 50,052-leaf grid.  Empty path data takes the
-        full way (which says why it is skipped).
-        """
-        path = self.paths.get(el.get("d") or "", False)[0]
-        if not path.cubics.shape[0]:
-            return False
-        inner = run.inner
-        self._add_shape(path, inner.ctm, run.decls, inner.chain + self._names.get(id(el), "path"))  # type: ignore[arg-type]
-        return True
 
     def _transform(self, el: ET.Element, style: dict[str, str], vp: Viewport) -> Matrix | None:
         """The element's own transform (CSS ``transform`` wins over the attribute), with its origin."""
@@ -378,7 +372,7 @@ class Reader:
                 return
             self._add_shape(geom.path, ctx.ctm, decls, source)
             if run is not None and tag == "path" and not (marks or facts.capped) and run.decls is decls:
-                run.plain = True  # visible, drawn whole, with shared declarations, kept
+                run.plain = decls  # visible, drawn whole, with shared declarations, kept
         if marks and not markers_first:
             self._markers(el, geom, ctx, decls)
 
@@ -386,7 +380,11 @@ class Reader:
         self.segments += path.cubics.shape[0]
         if self.segments > DEFAULT_MAX_SEGMENTS:
             raise LimitError(f"{self.name} draws more than {DEFAULT_MAX_SEGMENTS:,} path segments")
-        self.records.append(ShapeRecord(path, ctm, decls, source, self._next_order()))
+        records = self.records
+        if len(records) >= self.max_elements:  # (:meth:`_next_order`, inline: called for every shape)
+            raise LimitError(f"{self.name} draws more than {self.max_elements:,} elements")
+        self.order += 1
+        records.append(ShapeRecord(path, ctm, decls, source, self.order - 1))
 
     def _anisotropy(self, ctm: Matrix) -> float:
         """:func:`~.paint.anisotropy` of ``ctm``, remembered for the last matrix (siblings share theirs)."""
