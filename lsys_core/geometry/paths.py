@@ -162,9 +162,12 @@ def arrays_from_table(
     n_sub = np.where(bounds[1:] > bounds[:-1], np.append(sub, 0)[np.maximum(bounds[1:] - 1, 0)] + 1, 0)
     sub_at = np.concatenate([[0], np.cumsum(n_sub)]).tolist()
     at = bounds.tolist()
+    # Made by ``tuple.__new__`` (what the named tuple's own ``__new__`` calls, one Python call
+    # less) over zipped bounds: 47 -> 36 ms for 50,052 paths.
+    new = tuple.__new__
     return [
-        ArrayPath(cub[at[p] : at[p + 1]], sub[at[p] : at[p + 1]], tuple(closed[sub_at[p] : sub_at[p + 1]]))
-        for p in range(n_paths)
+        new(ArrayPath, (cub[a:b], sub[a:b], tuple(closed[c:d])))
+        for a, b, c, d in zip(at, at[1:], sub_at, sub_at[1:], strict=False)
     ]
 
 

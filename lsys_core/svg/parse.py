@@ -206,14 +206,17 @@ def _root_context(reader: Reader, root) -> tuple:
 def _elements(reader: Reader) -> tuple[list[Element], Counter]:
     """Transform the shape records into elements (one vectorised pass) and drop unusable ones."""
     skips: Counter = Counter(reader.skips)
-    recs = [
-        r for r in reader.records if isinstance(r, ShapeRecord) and r.path.cubics.shape[0] and not r.hidden
-    ]
+    recs = [r for r in reader.records if isinstance(r, ShapeRecord) and not r.hidden]
+    arrays = [r.path.cubics for r in recs]
+    counts = np.fromiter(map(len, arrays), dtype=np.intp, count=len(arrays))
+    if not counts.all():
+        kept = np.flatnonzero(counts).tolist()
+        recs, arrays, counts = [recs[i] for i in kept], [arrays[i] for i in kept], counts[kept]
     if not recs:
         return [], skips
-    counts = np.fromiter((r.path.cubics.shape[0] for r in recs), dtype=np.intp, count=len(recs))
     starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    cubics, seg_ok, spread = _placed(recs, counts)
+    cubics, seg_ok, spread = _placed(recs, arrays, counts, starts)
+    del arrays
     with np.errstate(invalid="ignore", over="ignore"):
         bad = np.add.reduceat((~seg_ok).astype(np.intp), starts) > 0
         extent = np.maximum.reduceat(spread, starts)
@@ -222,39 +225,36 @@ def _elements(reader: Reader) -> tuple[list[Element], Counter]:
     skips["degenerate (zero size)"] += int(flat.sum())
     cubics.flags.writeable = False
     lows, highs = starts.tolist(), (starts + counts).tolist()
-    out = []
+    out: list[Element] = []
     texts: dict[int, str] = {}  # records share declarations (the records hold them: ids stay unique)
+    append, new = out.append, object.__new__
     for i in np.flatnonzero(~(bad | flat)).tolist():
         r = recs[i]
-        sub = r.path.subpaths
+        path = r.path
+        sub = path.subpaths
         sub.flags.writeable = False
         style = texts.get(id(r.style))
         if style is None:
             style = texts[id(r.style)] = ";".join(map(":".join, r.style.items()))  # name:value;...
-        out.append(_element(cubics[lows[i] : highs[i]], sub, r.path.closed, style, r.source, r.order))
+        # Made without the frozen dataclass's ``__init__``, which sets each field through
+        # ``object.__setattr__``: 1.2 microseconds an element (60 ms of a 50,052-leaf grid), this
+        # 0.35; a test checks that the elements equal those the dataclass makes.
+        el = new(Element)
+        el.__dict__.update(
+            cubics=cubics[lows[i] : highs[i]],
+            subpaths=sub,
+            closed=path.closed,
+            style=style,
+            source=r.source,
+            order=r.order,
+        )
+        append(el)
     return out, skips
 
 
-def _element(
-    cubics: np.ndarray, subpaths: np.ndarray, closed: tuple[bool, ...], style: str, source: str, order: int
-) -> Element:
-    """``Element(cubics, subpaths, closed, style, source, order)``, its fields set at once.
-
-    A frozen dataclass sets each field through ``object.__setattr__``: 1.2 microseconds an
-    element, 60 ms of reading a 50,052-leaf grid; this takes 0.35 (a test checks that both
-    make the same element).
-    """
-    el = _new(Element)
-    el.__dict__.update(
-        cubics=cubics, subpaths=subpaths, closed=closed, style=style, source=source, order=order
-    )
-    return el
-
-
-_new = object.__new__
-
-
-def _placed(recs: list[ShapeRecord], counts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _placed(
+    recs: list[ShapeRecord], arrays: list[np.ndarray], counts: np.ndarray, starts: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """All records' cubics in document coordinates, which segments are usable, and their spread.
 
     Works in blocks of :data:`_BLOCK` segments, so a path of 10^6 segments needs a few MiB of
@@ -263,8 +263,8 @@ def _placed(recs: list[ShapeRecord], counts: np.ndarray) -> tuple[np.ndarray, np
     Returns the cubics ``(K, 4)``, finite and within :data:`MAX_COORD` per segment, and every
     segment's largest distance from its record's first point.
     """
-    first = np.array([r.path.cubics[0, 0] for r in recs], complex)
-    cubics = _joined(recs, counts)
+    cubics = _joined(arrays, counts)
+    first = cubics[starts, 0]  # (a copy, taken before the cubics are placed)
     mats = _matrices([r.ctm for r in recs])
     owner = np.repeat(np.arange(len(recs)), counts)
     with np.errstate(invalid="ignore", over="ignore"):
@@ -296,7 +296,7 @@ def _matrices(ctms: list[tuple[float, ...]]) -> np.ndarray:
     return np.array([ctms[i] for i in first.tolist()], dtype=float).reshape(-1, 6)[inverse.ravel()]
 
 
-def _joined(recs: list[ShapeRecord], counts: np.ndarray) -> np.ndarray:
+def _joined(arrays: list[np.ndarray], counts: np.ndarray) -> np.ndarray:
     """The records' cubics one after another: their own array when they are views that tile it.
 
     The path reader converts all paths of a document into one array; when the records hold
@@ -310,7 +310,6 @@ def _joined(recs: list[ShapeRecord], counts: np.ndarray) -> np.ndarray:
     pieces tile the array costs about 2 microseconds a record (40 ms of reading 20,000 leaves,
     whose copy takes 4 ms and 5 MiB).
     """
-    arrays = [r.path.cubics for r in recs]
     if int(counts.sum()) * 64 <= _SMALL_COPY:
         return np.concatenate(arrays)
     joined = consecutive(arrays)
@@ -320,7 +319,8 @@ def _joined(recs: list[ShapeRecord], counts: np.ndarray) -> np.ndarray:
         and owner.shape == (int(counts.sum()), 4)
         and owner.dtype == complex
         and owner.flags.writeable
-        and sys.getrefcount(owner) == len(recs) + 3  # a view per record, ``joined``, ``owner``, the argument
+        and sys.getrefcount(owner)
+        == len(arrays) + 3  # a view per record, ``joined``, ``owner``, the argument
     ):
         return owner
     return np.concatenate(arrays)
