@@ -232,7 +232,7 @@ def _elements(reader: Reader) -> tuple[list[Element], Counter]:
         r = recs[i]
         path = r.path
         sub = path.subpaths
-        sub.flags.writeable = False
+        sub.setflags(write=False)  # (0.13 microseconds; through ``flags``, 0.22)
         style = texts.get(id(r.style))
         if style is None:
             style = texts[id(r.style)] = ";".join(map(":".join, r.style.items()))  # name:value;...

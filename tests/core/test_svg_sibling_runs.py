@@ -131,3 +131,26 @@ def test_elements_equal_those_the_dataclass_makes():
         assert not e.cubics.flags.writeable and not e.subpaths.flags.writeable
         with pytest.raises(AttributeError):
             e.order = 0  # type: ignore[misc]
+
+
+def test_elements_of_a_kind_in_document_order_with_and_without_the_namespace():
+    import xml.etree.ElementTree as ET
+
+    from lsys_core.svg.records import source_names
+    from lsys_core.svg.tree import Tree
+
+    text = (
+        '<svg xmlns:s="http://www.w3.org/2000/svg"><path id="a"/><s:path/><g><path/><s:style/></g>'
+        "<s:path/><style/><path/></svg>"
+    )
+    tree = Tree(ET.fromstring(text))
+    order = [el for el in tree.root.iter() if el.tag.rpartition("}")[2] == "path"]
+    assert tree.of_kind("path") == order and len(order) == 5
+    assert len(tree.of_kind("style")) == 2 and tree.of_kind("rect") == []
+    assert [source_names(tree)[id(el)] for el in order] == [
+        "path#a",
+        "path[1]",
+        "path[2]",
+        "path[3]",
+        "path[4]",
+    ]
