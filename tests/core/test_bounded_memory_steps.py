@@ -108,9 +108,9 @@ def test_cubics_placed_in_place_or_copied_are_the_same(monkeypatch):
     in_place = []
     joined = parse._joined
 
-    def spy(recs, counts):
-        got = joined(recs, counts)
-        in_place.append(got is recs[0].path.cubics.base)
+    def spy(arrays, counts):
+        got = joined(arrays, counts)
+        in_place.append(got is arrays[0].base)
         return got
 
     monkeypatch.setattr(parse, "_joined", spy)
