@@ -114,3 +114,27 @@ def test_usage_error_exits_2() -> None:
     p = run("derive")
     assert p.returncode == 2
     assert "Traceback" not in p.stderr
+
+
+def test_main_in_process_leaves_the_garbage_collector_as_it_was(tmp_path) -> None:
+    """``infer`` imports with the collector paused and freezes the modules; ``main`` undoes both."""
+    import gc
+
+    from lsys_core.cli import main
+
+    src = tmp_path / "in.svg"
+    src.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 20">'
+        + "".join(f'<rect x="{10 * i}" y="5" width="5" height="5"/>' for i in range(6))
+        + "</svg>"
+    )
+    assert gc.isenabled()
+    assert main(["-q", "infer", str(src), "-o", str(tmp_path / "r.lsys")]) == 0
+    assert gc.isenabled() and gc.get_freeze_count() == 0
+    gc.disable()
+    try:
+        assert main(["-q", "infer", str(src), "-o", str(tmp_path / "r2.lsys")]) == 0
+        assert not gc.isenabled()
+    finally:
+        gc.enable()
+    assert (tmp_path / "r.lsys").read_bytes() == (tmp_path / "r2.lsys").read_bytes()
