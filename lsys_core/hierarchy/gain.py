@@ -94,6 +94,8 @@ class Ledger:
         #: the keys of every family, increasing (what ``key_family == f`` selects)
         self.family_keys = [by_family[cuts[f] : cuts[f + 1]] for f in range(n_fam)]
         self._tables: dict[int, np.ndarray] = {}
+        #: the bits of every family's whole set (what :meth:`_moved` subtracts from), by family
+        self._whole: dict[int, float] = {}
         self._last: tuple[Groups, tuple[float, float, np.ndarray, np.ndarray]] | None = None
         self.pose = np.array([self._key_pose(f, self.stacked[self.family_keys[f]]) for f in range(n_fam)])
 
@@ -202,17 +204,18 @@ class Ledger:
         saved = 0.0
         removed = np.bincount(self.cell[nodes], minlength=self.stacked.size)
         left = self.stacked - removed
-        for f in np.unique(fam):
-            f = int(f)
+        for f in sorted_unique(fam).tolist():
             taken = fam == f
-            n, k = int(self.count[f]), int(taken.sum())
+            n, k = int(self.count[f]), int(np.count_nonzero(taken))
             mine = self.family_keys[f]
             u = int(np.count_nonzero(left[mine] > 0))
-            before = self._family_bits(f, n, float(self.counts[f]))
+            before = self._whole.get(f)
+            if before is None:
+                before = self._whole[f] = self._family_bits(f, n, float(self.counts[f]))
             counts = float(self.counts[f] - self.node_counts[nodes[taken]].sum())
             saved += before - self._family_bits(f, n - k, counts, u, self._key_pose(f, left[mine]))
         first = c.groups.firsts
-        _, stacks = np.unique(self.cell[first], return_counts=True)
+        stacks = _run_lengths(np.sort(self.cell[first]))  # np.unique(..., return_counts=True)[1]
         new = placement_set_bits(self.prec, len(c.groups), occupied=stacks.size, token=self.token)
         out = (saved, float(new), first, stacks)
         self._last = (c.groups, out)
@@ -231,6 +234,14 @@ class Ledger:
             runs = [transform_bits(self.prec, *c.first), transform_bits(self.prec, *c.second)]
             return structured_bits(self.prec, self.token, refs, runs)
         return rule_bits(self.prec, self.token, Rule("_", True, rule_cases(self.table, c, "_")))
+
+
+def _run_lengths(s: np.ndarray) -> np.ndarray:
+    """The lengths of the runs of equal values of a sorted array (``np.unique``'s counts, without hashing)."""
+    if s.size == 0:
+        return np.zeros(0, np.intp)
+    cuts = np.flatnonzero(s[1:] != s[:-1]) + 1
+    return np.diff(np.concatenate([[0], cuts, [s.size]])).astype(np.intp)
 
 
 def group_reach(nodes: Nodes, groups: Groups | Sequence[np.ndarray]) -> np.ndarray:

@@ -18,7 +18,13 @@ from lsys_core.hierarchy.clustering import RANK, mean_shift, rank_order, ranked_
 from lsys_core.hierarchy.flat import Groups, greedy_disjoint
 from lsys_core.hierarchy.gain import Ledger, cluster_bounds
 from lsys_core.hierarchy.spaces import PairSpace
-from lsys_core.sorting import row_groups, sorted_unique, stable_argsort
+from lsys_core.sorting import (
+    dense_fits,
+    distinct_counts,
+    row_groups,
+    sorted_unique,
+    stable_argsort,
+)
 
 __all__ = ["linear_candidates"]
 
@@ -184,6 +190,14 @@ def _promising(
         members = order[starts[lo] : starts[hi]]
         lab = np.repeat(np.arange(lo, hi, dtype=np.int64), np.diff(starts[lo : hi + 1]))
         a, b = e1[members], e2[members]
+        if dense_fits(hi - lo, int(m), 2 * a.size):
+            # few cells: count distinct pairs and nodes by marking them (the same counts)
+            lab2 = np.concatenate([lab, lab]) - lo
+            ends = np.concatenate([ps.src[a], ps.src[b], ps.dst[a], ps.dst[b]])
+            return (
+                distinct_counts(lab2, np.concatenate([a, b]), hi - lo, int(m)),
+                distinct_counts(np.concatenate([lab2, lab2]), ends, hi - lo, int(n)),
+            )
         keys = sorted_unique(np.concatenate([lab * m + a, lab * m + b]))
         lab, pair = np.divmod(keys, m)
         n_pairs = np.bincount(lab - lo, minlength=hi - lo)

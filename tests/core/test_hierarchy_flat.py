@@ -111,3 +111,15 @@ def test_chains_slicing_and_helpers() -> None:
     assert c.nodes[lo].tolist() == [4, 5, 8] and c.nodes[hi].tolist() == [5, 6, 9]
     assert sorted_unique(np.array([3, 1, 3, 2])).tolist() == [1, 2, 3]
     assert isin(np.array([1, 5, 2]), np.array([2, 1, 1])).tolist() == [True, False, True]
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_greedy_disjoint_matches_the_sequential_pass_without_repeating_chains(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    count = int(rng.integers(1, 300))
+    universe = int(rng.integers(4, 120))
+    chains = [rng.integers(0, universe, size=int(rng.integers(1, 6))).tolist() for _ in range(count)]
+    order = rng.permutation(count)[: int(rng.integers(0, count + 1))]
+    distinct = [c for c in order.tolist() if len(set(chains[c])) == len(chains[c])]
+    got = greedy_disjoint(Groups.of(chains), order, universe)
+    assert got.tolist() == _greedy_reference(chains, distinct)

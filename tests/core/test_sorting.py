@@ -45,3 +45,18 @@ def test_row_groups_are_numpys(seed: int) -> None:
     assert got[2].tolist() == counts.tolist()
     empty = row_groups([np.zeros(0), np.zeros(0, int)])
     assert all(x.size == 0 for x in empty)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_distinct_counts_mark_or_sort_to_the_definition(seed: int, monkeypatch) -> None:
+    from lsys_core import sorting
+
+    rng = np.random.default_rng(seed)
+    n_labels, size = int(rng.integers(1, 60)), int(rng.integers(1, 5000))
+    n = int(rng.integers(0, 4000))
+    labels, values = rng.integers(0, n_labels, n), rng.integers(0, size, n)
+    want = np.bincount(np.unique(labels * size + values) // size, minlength=n_labels)
+    assert sorting.distinct_counts(labels, values, n_labels, size).tolist() == want.tolist()
+    monkeypatch.setattr(sorting, "DENSE_CELLS", 0)  # the sorting path
+    assert not sorting.dense_fits(n_labels, size, n)
+    assert sorting.distinct_counts(labels, values, n_labels, size).tolist() == want.tolist()

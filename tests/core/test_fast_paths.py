@@ -1,0 +1,46 @@
+"""Fast paths for small inputs give what the general code gives: rules compared with them off."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lsys_core import sorting
+from lsys_core.derive.derivation import derive
+from lsys_core.grammar import format_grammar
+from lsys_core.pipeline import infer
+
+from .scenes import LEAF, place, pose, scene
+
+
+def _rotating_grid(rows: int, cols: int):
+    """Leaves whose rotation grows 12° per column: linear sequences and constant pairs."""
+    frames = [pose(40.0 * c, 40.0 * r, 12.0 * c) for r in range(rows) for c in range(cols)]
+    return scene(place(LEAF, frames))
+
+
+def _rules(grid):
+    result = infer(grid)
+    return format_grammar(result.grammar), derive(result.grammar), result.log
+
+
+def test_distinct_counts_by_marking_give_the_rules_of_sorting(monkeypatch) -> None:
+    grid = _rotating_grid(12, 16)
+    marked: list[bool] = []
+    fits = sorting.dense_fits
+
+    def spy(n_labels: int, size: int, entries: int) -> bool:
+        marked.append(fits(n_labels, size, entries))
+        return marked[-1]
+
+    monkeypatch.setattr(sorting, "dense_fits", spy)
+    import lsys_core.hierarchy.linear as linear
+
+    monkeypatch.setattr(linear, "dense_fits", spy)
+    fast = _rules(grid)
+    assert any(marked)  # the marking path ran
+    monkeypatch.setattr(sorting, "DENSE_CELLS", 0)
+    marked.clear()
+    slow = _rules(grid)
+    assert not any(marked)
+    assert fast[0] == slow[0] and fast[2] == slow[2]
+    assert np.array_equal(fast[1].a, slow[1].a) and np.array_equal(fast[1].b, slow[1].b)
