@@ -122,9 +122,11 @@ class Groups:
         return Groups(self.nodes[pos], offsets)
 
     def head(self, count: int) -> Groups:
-        """Every chain cut to its first ``count`` nodes."""
-        lengths = np.minimum(self.lengths, count)
-        return self.take_prefix(lengths)
+        """Every chain cut to its first ``count`` nodes (these groups themselves when none is longer)."""
+        lengths = self.lengths
+        if lengths.size == 0 or int(lengths.max()) <= count:
+            return self  # nothing to cut (immutable: sharing is safe)
+        return self.take_prefix(np.minimum(lengths, count))
 
     def take_prefix(self, lengths: np.ndarray) -> Groups:
         """Every chain cut to its first ``lengths[k]`` nodes."""
