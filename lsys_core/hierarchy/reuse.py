@@ -43,12 +43,16 @@ def start_orders(cands: list[Candidate], first: np.ndarray) -> list[tuple[float,
     exact and the means those of ``np.mean``.
     """
     counts = np.array([len(c.groups) for c in cands], np.int64)
-    heads = np.concatenate([c.groups.firsts for c in cands]) if cands else np.zeros(0, np.int64)
-    seconds = (
-        np.concatenate([c.groups.nodes[c.groups.offsets[:-1] + (c.groups.lengths > 1)] for c in cands])
-        if cands
-        else np.zeros(0, np.int64)
-    )
+    if cands:
+        # every candidate's groups in one flat array: its group bounds shifted by the nodes before it
+        sizes = np.array([c.groups.nodes.size for c in cands], np.int64)
+        flat = np.concatenate([c.groups.nodes for c in cands])
+        shift = np.repeat(np.cumsum(sizes) - sizes, counts)
+        lo = np.concatenate([c.groups.offsets[:-1] for c in cands]) + shift
+        hi = np.concatenate([c.groups.offsets[1:] for c in cands]) + shift
+        heads, seconds = flat[lo], flat[lo + (hi - lo > 1)]
+    else:
+        heads = seconds = np.zeros(0, np.int64)
     offsets = np.concatenate(([0], np.cumsum(counts)[:-1]))
     order = np.asarray(first, np.float64)
     head = np.add.reduceat(order[heads], offsets) / counts

@@ -44,3 +44,36 @@ def test_distinct_counts_by_marking_give_the_rules_of_sorting(monkeypatch) -> No
     assert not any(marked)
     assert fast[0] == slow[0] and fast[2] == slow[2]
     assert np.array_equal(fast[1].a, slow[1].a) and np.array_equal(fast[1].b, slow[1].b)
+
+
+def test_start_orders_in_one_pass_are_the_per_candidate_means() -> None:
+    from lsys_core.hierarchy.candidates import SeqCandidate
+    from lsys_core.hierarchy.flat import Groups
+    from lsys_core.hierarchy.reuse import start_orders
+
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        n = 200
+        cands = [
+            SeqCandidate(
+                space=(0, 0),
+                groups=Groups.of(
+                    [rng.integers(0, n, int(rng.integers(1, 5))) for _ in range(int(rng.integers(1, 6)))]
+                ),
+                h=1.0,
+                phi=1.0,
+                l=1.0,
+                A=1 + 0j,
+                B=0j,
+            )
+            for _ in range(int(rng.integers(1, 20)))
+        ]
+        first = rng.permutation(n).astype(np.float64)
+        want = [
+            (
+                float(np.mean(first[c.groups.firsts])),
+                float(np.mean(first[[g[1] if g.size > 1 else g[0] for g in c.groups]])),
+            )
+            for c in cands
+        ]
+        assert start_orders(cands, first) == want
