@@ -22,7 +22,7 @@ from lsys_core.hierarchy.candidates import (
     Context,
     PairCandidate,
     SeqCandidate,
-    mean_rel,
+    cluster_means,
     proximity,
     space_key,
 )
@@ -99,18 +99,20 @@ def find_candidates(
     pending: list[tuple[int, ConstantCluster]] = []
     clusters = [idx for idx in group_indices(labels) if idx.size >= 2]  # a single pair repeats nothing
     costs = spread(emb[:, :5], clusters)
-    for idx, linked in zip(clusters, link_clusters(clusters, costs, ps.src, ps.dst, n_nodes), strict=True):
+    links = link_clusters(clusters, costs, ps.src, ps.dst, n_nodes)
+    means = cluster_means(ps.A, ps.B, prox, [lk.used if len(lk.chains) else lk.used[:0] for lk in links])
+    for idx, linked, mean in zip(clusters, links, means, strict=True):
         si, sj = int(sym[ps.src[idx[0]]]), int(sym[ps.dst[idx[0]]])
-        chain_list, used = linked.chains, linked.used
-        if len(chain_list) == 0:
+        chain_list = linked.chains
+        if len(chain_list) == 0 or mean is None:
             continue
         cluster = ConstantCluster((si, sj), idx, linked.src, linked.dst)
         found.append(cluster)
-        A, B = mean_rel(ps.A[used], ps.B[used])
+        A, B, h = mean  # mean_rel(ps.A[used], ps.B[used]) and np.mean(prox[used]), for all clusters at once
         lengths = chain_list.lengths - 1
         if len(chain_list) < 2 and lengths.max() < 2:
             continue
-        h, phi = float(np.mean(prox[used])), ctx.phi(si, sj)
+        phi = ctx.phi(si, sj)
         cand: Candidate
         if si == sj and lengths.max() >= 2:
             cand = SeqCandidate(

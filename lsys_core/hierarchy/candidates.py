@@ -27,6 +27,7 @@ __all__ = [
     "LinearCandidate",
     "PairCandidate",
     "SeqCandidate",
+    "cluster_means",
     "mean_rel",
     "proximity",
     "space_key",
@@ -166,6 +167,42 @@ def mean_rel(A: np.ndarray, B: np.ndarray) -> tuple[complex, complex]:
     la = np.log(A)
     ang = np.angle(np.mean(np.exp(1j * la.imag)))
     return complex(np.exp(np.mean(la.real) + 1j * ang)), complex(np.mean(B))
+
+
+def cluster_means(
+    A: np.ndarray, B: np.ndarray, h: np.ndarray, members: list[np.ndarray]
+) -> list[tuple[complex, complex, float] | None]:
+    """``mean_rel(A[m], B[m])`` and ``float(np.mean(h[m]))`` of every ``m`` in ``members`` (None when empty).
+
+    The same values as one call per cluster, with a few numpy calls per cluster *length*:
+    the logarithms and unit turns are taken per pair (the same per element), and the members
+    of all clusters of one length are stacked as rows whose means (``axis=1``: each row reduced
+    as one array, pairwise) are those of the rows alone.  Only the turn of each mean is taken
+    one by one, on its scalar, as :func:`mean_rel` does.  A 1,200-leaf grid has ~800 clusters
+    of a few dozen lengths: one ``mean_rel`` each was 3 % of its ``lsys infer`` (sampled).
+    """
+    out: list[tuple[complex, complex, float] | None] = [None] * len(members)
+    sizes = np.array([m.size for m in members], np.int64)
+    keep = np.flatnonzero(sizes > 0)
+    if keep.size == 0:
+        return out
+    flat = np.concatenate([members[k] for k in keep.tolist()])
+    la = np.log(A[flat])
+    unit = np.exp(1j * la.imag)
+    log_abs, b, near = la.real, B[flat], h[flat]
+    start = np.cumsum(sizes[keep]) - sizes[keep]
+    by_size = keep[np.argsort(sizes[keep], kind="stable")]
+    pos = np.empty(len(members), np.int64)
+    pos[keep] = start
+    cuts = np.flatnonzero(np.diff(sizes[by_size])) + 1
+    for group in np.split(by_size, cuts):
+        rows = pos[group][:, None] + np.arange(int(sizes[group[0]]))
+        turn, scale = np.mean(unit[rows], axis=1), np.mean(log_abs[rows], axis=1)
+        shift, hs = np.mean(b[rows], axis=1), np.mean(near[rows], axis=1)
+        for j, k in enumerate(group.tolist()):
+            ang = np.angle(turn[j])
+            out[k] = (complex(np.exp(scale[j] + 1j * ang)), complex(shift[j]), float(hs[j]))
+    return out
 
 
 def space_key(sym: np.ndarray, ps: PairSpace) -> np.ndarray:

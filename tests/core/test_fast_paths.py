@@ -77,3 +77,24 @@ def test_start_orders_in_one_pass_are_the_per_candidate_means() -> None:
             for c in cands
         ]
         assert start_orders(cands, first) == want
+
+
+def test_cluster_means_at_once_are_the_per_cluster_means() -> None:
+    from lsys_core.hierarchy.candidates import cluster_means, mean_rel
+
+    rng = np.random.default_rng(11)
+    for _ in range(40):
+        n = int(rng.integers(50, 3000))
+        A = np.exp(rng.normal(size=n) * rng.uniform(0, 2) + 1j * rng.uniform(-np.pi, np.pi, n))
+        B = (rng.normal(size=n) + 1j * rng.normal(size=n)) * 10 ** rng.uniform(-3, 4)
+        h = rng.uniform(0, 1, n)
+        perm, members, i = rng.permutation(n), [], 0
+        while i < n and len(members) < 300:
+            size = int(rng.choice([0, 1, 2, 2, 3, 4, 5, 9, 17, 64, 130]))
+            members.append(np.sort(perm[i : i + size]))
+            i += size
+        for m, got in zip(members, cluster_means(A, B, h, members), strict=True):
+            if m.size == 0:
+                assert got is None
+            else:
+                assert got == (*mean_rel(A[m], B[m]), float(np.mean(h[m])))
