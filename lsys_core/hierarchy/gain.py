@@ -38,7 +38,7 @@ from lsys_core.hierarchy.mdl import (
 )
 from lsys_core.hierarchy.nodes import Nodes
 from lsys_core.hierarchy.symbols import SymbolTable
-from lsys_core.sorting import sorted_unique
+from lsys_core.sorting import distinct_counts, sorted_unique
 
 __all__ = ["Ledger", "cluster_bounds", "group_reach", "placement_error"]
 
@@ -274,11 +274,8 @@ def cluster_bounds(ledger: Ledger, labels: np.ndarray, src: np.ndarray, dst: np.
     c = np.bincount(lab, minlength=n_lab)
     n = len(ledger.nodes)
 
-    def distinct(x: np.ndarray) -> np.ndarray:
-        return np.bincount(sorted_unique(lab * n + x) // n, minlength=n_lab)
-
-    both = np.bincount(sorted_unique(np.concatenate([lab * n + s, lab * n + d])) // n, minlength=n_lab)
-    n_src, n_dst = distinct(s), distinct(d)
+    both = distinct_counts(np.concatenate([lab, lab]), np.concatenate([s, d]), n_lab, n)
+    n_src, n_dst = distinct_counts(lab, s, n_lab, n), distinct_counts(lab, d, n_lab, n)
     fam_s = np.zeros(n_lab, int)
     fam_d = np.zeros(n_lab, int)
     fam_s[lab] = ledger.family[s]
