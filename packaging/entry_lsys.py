@@ -1,8 +1,6 @@
 """Frozen entry point of ``lsys`` (see lsys-editor.spec)."""
 
-import sys
-
 if __name__ == "__main__":
-    from lsys_core.cli import main
+    from lsys_core.cli import run
 
-    sys.exit(main())
+    run()
