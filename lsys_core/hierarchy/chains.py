@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lsys_core import parallel
 from lsys_core.hierarchy.flat import Groups, follow_links, greedy_links, isin
 from lsys_core.sorting import first_occurrences, sorted_unique, stable_argsort
 
@@ -45,6 +46,11 @@ def link_clusters(
 
     Per cluster, pairs are taken greedily from the cheapest (ties in pair order), each node
     keeping ≤ 1 successor and ≤ 1 predecessor, and the links are followed into chains.
+    Clusters are linked on their own, so from :data:`_SPLIT` pairs up they are linked in runs
+    of about equal pairs on the :func:`~lsys_core.parallel.jobs` workers (numpy's sorts release
+    the interpreter): the same chains.  A 50,052-leaf grid's 1.2·10^6 pairs took 3.2 s of the
+    main thread's 6 s of clustering with 2 jobs, one core idle once the linear sequences beside
+    it had ended; in parts the whole inference took 8.52 -> 8.25 s (3 pairs).
 
     Parameters
     ----------
@@ -60,6 +66,40 @@ def link_clusters(
     count = len(clusters)
     if count == 0:
         return []
+    sizes = np.fromiter((c.size for c in clusters), np.int64, count)
+    parts = _parts(sizes, parallel.jobs())
+    if len(parts) > 1:
+        ends = np.concatenate([[0], np.cumsum(sizes)])
+        return [
+            linked
+            for part in parallel.pmap(
+                lambda p: _link(clusters[p[0] : p[1]], costs[ends[p[0]] : ends[p[1]]], src, dst, n_nodes),
+                parts,
+            )
+            for linked in part
+        ]
+    return _link(clusters, costs, src, dst, n_nodes)
+
+
+#: Pairs from which the clusters of a level are linked in parts, one per worker.
+_SPLIT = 200_000
+
+
+def _parts(sizes: np.ndarray, workers: int) -> list[tuple[int, int]]:
+    """Consecutive runs of clusters of about equal pairs, one per worker (one run below :data:`_SPLIT` pairs)."""
+    total = int(sizes.sum())
+    if workers < 2 or total < _SPLIT or sizes.size < 2:
+        return [(0, int(sizes.size))]
+    cuts = np.searchsorted(np.cumsum(sizes), total * np.arange(1, workers) / workers, side="right")
+    bounds = sorted_unique(np.concatenate([[0], np.minimum(cuts, sizes.size - 1), [sizes.size]]))
+    return list(zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True))
+
+
+def _link(
+    clusters: list[np.ndarray], costs: np.ndarray, src: np.ndarray, dst: np.ndarray, n_nodes: int
+) -> list[Linked]:
+    """:func:`link_clusters` of some clusters, in one pass."""
+    count = len(clusters)
     n = np.int64(max(n_nodes, 1))
     items = np.concatenate(clusters)
     cid = np.repeat(np.arange(count, dtype=np.int64), [c.size for c in clusters])

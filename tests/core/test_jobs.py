@@ -187,3 +187,31 @@ def test_a_command_process_reuses_freed_large_arrays() -> None:
     # 64 MiB given back and cleared again (page faults: 2,720 here with huge pages) five times,
     # unless kept for reuse (0 here)
     assert faults("keep") * 10 < faults("plain")
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_clusters_linked_in_parts_are_linked_as_at_once(seed, restore_jobs, monkeypatch) -> None:
+    from lsys_core.hierarchy import chains
+
+    rng = np.random.default_rng(seed)
+    n_nodes, n_pairs = 300, 4_000
+    src, dst = rng.integers(0, n_nodes, n_pairs), rng.integers(0, n_nodes, n_pairs)
+    sizes = rng.integers(1, 400, 30)
+    sizes = sizes[np.cumsum(sizes) <= n_pairs]
+    members = np.split(rng.permutation(n_pairs)[: sizes.sum()], np.cumsum(sizes)[:-1])
+    clusters = [np.sort(m) for m in members]
+    costs = np.round(rng.uniform(0, 3, int(sizes.sum())), 1)  # ties: pair order decides
+    monkeypatch.setattr(chains, "_SPLIT", 10)
+    runs = {}
+    for jobs in (1, 2, 3):
+        parallel.set_jobs(jobs)
+        assert len(chains._parts(sizes, jobs)) == min(jobs, sizes.size)
+        runs[jobs] = chains.link_clusters(clusters, costs, src, dst, n_nodes)
+    for jobs in (2, 3):
+        for a, b in zip(runs[1], runs[jobs], strict=True):
+            assert a.chains.tolist() == b.chains.tolist()
+            assert (
+                np.array_equal(a.used, b.used)
+                and np.array_equal(a.src, b.src)
+                and np.array_equal(a.dst, b.dst)
+            )
