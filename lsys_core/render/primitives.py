@@ -26,7 +26,7 @@ import numpy as np
 from lsys_core.geometry.bezier import sample_cubics
 from lsys_core.geometry.shapes import shape_arrays
 
-__all__ = ["TOLERANCE", "primitive", "primitive_of"]
+__all__ = ["TOLERANCE", "chord_frame", "primitive", "primitive_of"]
 
 #: Largest distance, relative to the shape's size, between the path and the element written for it.
 TOLERANCE = 1e-3
@@ -44,12 +44,15 @@ def _num(v: float, unit: float = 0.0) -> str:
     return "0" if text == "-0" else text
 
 
-def _straight(cubics: np.ndarray, tol: float, max_angle: float = 1e-3) -> np.ndarray:
-    """Whether each segment is a straight line (control points on the chord, between its ends).
+def chord_frame(
+    cubics: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, list[np.ndarray], np.ndarray, np.ndarray, np.ndarray]:
+    """What the straightness test reads of each segment, measured along its chord.
 
-    It must also leave and arrive along its chord: a control point a hair off the chord next to
-    an end turns the tangent there (and so a stroke's cap or join) far from the chord's
-    direction, although the curve stays within the tolerance.
+    Returns the chord's ``length``, the chord itself where it has one (1 where not: ``safe``),
+    the two control points relative to the chord (``rel``: 0 at the start, 1 at the end), their
+    largest distance from it (``off``), and the tangents at the start and end (``start``,
+    ``end``: towards the first control point that is not on that end).
     """
     p0, p1, p2, p3 = (cubics[:, k] for k in range(4))
     chord = p3 - p0
@@ -57,10 +60,20 @@ def _straight(cubics: np.ndarray, tol: float, max_angle: float = 1e-3) -> np.nda
     safe = np.where(length > 0, chord, 1.0)
     rel = [(p - p0) / safe for p in (p1, p2)]
     off = np.maximum(np.abs(rel[0].imag), np.abs(rel[1].imag)) * length
-    inside = np.all([(r.real > -tol) & (r.real < 1 + tol) for r in rel], axis=0)
-    # the tangent at each end: towards the first control point that is not on that end
     start = np.where(p1 != p0, p1 - p0, np.where(p2 != p0, p2 - p0, chord))
     end = np.where(p2 != p3, p3 - p2, np.where(p1 != p3, p3 - p1, chord))
+    return length, safe, rel, off, start, end
+
+
+def _straight(cubics: np.ndarray, tol: float, max_angle: float = 1e-3) -> np.ndarray:
+    """Whether each segment is a straight line (control points on the chord, between its ends).
+
+    It must also leave and arrive along its chord: a control point a hair off the chord next to
+    an end turns the tangent there (and so a stroke's cap or join) far from the chord's
+    direction, although the curve stays within the tolerance.
+    """
+    length, safe, rel, off, start, end = chord_frame(cubics)
+    inside = np.all([(r.real > -tol) & (r.real < 1 + tol) for r in rel], axis=0)
     along = (np.abs(np.angle(start / safe)) <= max_angle) & (np.abs(np.angle(end / safe)) <= max_angle)
     return (length > 0) & (off <= tol) & inside & along
 

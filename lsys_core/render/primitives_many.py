@@ -24,7 +24,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from lsys_core.geometry.shapes import shapes_arrays
-from lsys_core.render.primitives import TOLERANCE, primitive_of
+from lsys_core.render.primitives import TOLERANCE, chord_frame, primitive_of
 
 __all__ = ["Shape", "primitives"]
 
@@ -113,14 +113,7 @@ def _straight_bounds(
     Returns ``(straight, unsure)``: what the test says, and where a condition is so close to
     its threshold that the full test might say otherwise.
     """
-    p0, p1, p2, p3 = (cubics[:, k] for k in range(4))
-    chord = p3 - p0
-    length = np.abs(chord)
-    safe = np.where(length > 0, chord, 1.0)
-    rel = [(p - p0) / safe for p in (p1, p2)]
-    off = np.maximum(np.abs(rel[0].imag), np.abs(rel[1].imag)) * length
-    start = np.where(p1 != p0, p1 - p0, np.where(p2 != p0, p2 - p0, chord))
-    end = np.where(p2 != p3, p3 - p2, np.where(p1 != p3, p3 - p1, chord))
+    length, safe, rel, off, start, end = chord_frame(cubics)
     # every condition as slack >= 0 (or > 0) and the scale of its rounding
     slack = [(tol - off, tol + off)]
     slack += [(r.real + tol, np.abs(r.real) + tol) for r in rel]
