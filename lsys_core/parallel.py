@@ -30,7 +30,7 @@ from typing import TypeVar
 
 from lsys_core.errors import LsysError
 
-__all__ = ["MAX_JOBS", "available_cores", "jobs", "keep_freed_memory", "pmap", "set_jobs", "submit"]
+__all__ = ["MAX_JOBS", "available_cores", "jobs", "keep_freed_memory", "pmap", "runs", "set_jobs", "submit"]
 
 #: Largest accepted number of workers.
 MAX_JOBS = 256
@@ -148,3 +148,22 @@ def submit(fn: Callable[..., R], *args, **kwargs) -> Future[R]:
     fut = pool.submit(fn, *args, **kwargs)
     pool.shutdown(wait=False)
     return fut
+
+
+def runs(sizes: Iterable[int], cap: int) -> list[tuple[int, int]]:
+    """Split items of these sizes into runs, in order, each of ≤ ``cap`` (a larger item is a run of its own).
+
+    For independent items (clusters, texts) worked in runs whose results are concatenated in
+    order: memory stays bounded whatever the input's size, and small inputs stay in one run.
+    Returns ``(lo, hi)`` item ranges.
+    """
+    out, lo, acc, count = [], 0, 0, 0
+    for i, size in enumerate(sizes):
+        if acc and acc + size > cap:
+            out.append((lo, i))
+            lo, acc = i, 0
+        acc += size
+        count = i + 1
+    if count:
+        out.append((lo, count))
+    return out

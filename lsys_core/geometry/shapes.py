@@ -20,8 +20,9 @@ import numpy as np
 
 from lsys_core.geometry.pathdata import parse_paths
 from lsys_core.geometry.paths import arrays_from_table, cubics_from_d
+from lsys_core.parallel import runs
 
-__all__ = ["CACHE_SEGMENTS", "PASS_CHARS", "shape_arrays", "shapes_arrays"]
+__all__ = ["CACHE_SEGMENTS", "PASS_CHARS", "ptp_at", "shape_arrays", "shapes_arrays"]
 
 #: Characters of path data parsed in one pass by :func:`shapes_arrays` (the lexer's temporaries
 #: are some 30 bytes a character: 1.2 MB of texts in one pass peaked at 40 MiB).
@@ -127,14 +128,8 @@ def shapes_arrays(ds: Sequence[str]) -> list[_Arrays | None]:
         else:
             out[i] = _one(d)
     texts = list(batch)
-    lo = 0
-    while lo < len(texts):
-        hi, length = lo, 0
-        while hi < len(texts) and (hi == lo or length + len(texts[hi]) <= PASS_CHARS):
-            length += len(texts[hi]) + 1
-            hi += 1
+    for lo, hi in runs([len(d) + 1 for d in texts], PASS_CHARS + 1):  # each text and a separator
         _parse_pass(texts[lo:hi], batch, out)
-        lo = hi
     return out
 
 
@@ -159,3 +154,8 @@ def _one(d: str) -> _Arrays | None:
         return shape_arrays(d)
     except Exception:  # unreadable path data (as primitive() and compact_path_data() treat it)
         return None
+
+
+def ptp_at(values: np.ndarray, starts: np.ndarray) -> np.ndarray:
+    """Peak to peak of each ``(k, 4)`` block of rows (a shape's segments) starting at ``starts`` (exact: max - min)."""
+    return np.maximum.reduceat(values.max(axis=1), starts) - np.minimum.reduceat(values.min(axis=1), starts)

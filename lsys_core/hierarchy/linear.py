@@ -82,7 +82,7 @@ def linear_candidates(
         take = np.sort(by_cluster[bounds[part[0]] : bounds[part[1]]])  # in the order of the pairs
         return _part_candidates(ctx, sym, ps, prox, idx[take], lab[take], ledger)
 
-    solved = parallel.pmap(solve, _runs(np.diff(bounds).tolist(), _PART))
+    solved = parallel.pmap(solve, parallel.runs(np.diff(bounds).tolist(), _PART))
     found = [c for part, _ in solved for c in part]
     rank = np.concatenate([r for _, r in solved])
     return [found[k] for k in rank_order(rank)]
@@ -143,7 +143,7 @@ def _part_candidates(
         ranks.append(label)
     del emb2, lab2, order, e1, e2, cluster  # millions of consecutive pairs at 50,000 elements
     sizes = [p[0].size for p in problems]
-    runs = _runs(sizes, _BATCH) if sum(sizes) >= _SPLIT else [(0, len(problems))]
+    runs = parallel.runs(sizes, _BATCH) if sum(sizes) >= _SPLIT else [(0, len(problems))]
     solved = [
         c
         for part in parallel.pmap(
@@ -153,24 +153,6 @@ def _part_candidates(
     ]
     found = [k for k, c in enumerate(solved) if c is not None]
     return [c for c in solved if c is not None], rank[np.asarray(ranks, np.int64)[found]]
-
-
-def _runs(sizes: list[int], cap: int) -> list[tuple[int, int]]:
-    """Split items of these sizes into runs, in order, each of ≤ ``cap`` (a larger item is a run of its own).
-
-    The items (clusters, step clusters) are independent problems, so the runs can be solved
-    on their own and their results concatenated in order; memory stays bounded whatever the
-    scene's size, and small inputs stay in one run.
-    """
-    runs, lo, acc = [], 0, 0
-    for i, size in enumerate(sizes):
-        if acc and acc + size > cap:
-            runs.append((lo, i))
-            lo, acc = i, 0
-        acc += size
-    if sizes:
-        runs.append((lo, len(sizes)))
-    return runs
 
 
 def _promising(
@@ -205,7 +187,7 @@ def _promising(
         nodes = sorted_unique(np.concatenate([lab * n + ps.src[pair], lab * n + ps.dst[pair]]))
         return n_pairs, np.bincount(nodes // n - lo, minlength=hi - lo)
 
-    counted = parallel.pmap(count, _runs(np.diff(starts).tolist(), _BATCH))
+    counted = parallel.pmap(count, parallel.runs(np.diff(starts).tolist(), _BATCH))
     n_pairs = np.concatenate([c[0] for c in counted]) if counted else np.zeros(0, np.int64)
     n_nodes = np.concatenate([c[1] for c in counted]) if counted else np.zeros(0, np.int64)
     fam = ledger.family[ps.src[e1[order[starts[1:] - 1]]]]  # the last member's, as one assignment gives

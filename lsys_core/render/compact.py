@@ -20,7 +20,8 @@ from collections.abc import Iterator
 import numpy as np
 
 from lsys_core.errors import LsysError
-from lsys_core.geometry.shapes import shape_arrays, shapes_arrays
+from lsys_core.geometry.shapes import ptp_at, shape_arrays, shapes_arrays
+from lsys_core.parallel import runs
 
 __all__ = ["PATH_PRECISION", "compact_path_data", "compact_paths"]
 
@@ -82,7 +83,7 @@ def compact_paths(ds: list[str], block: int = 1 << 16) -> list[str]:
     with np.errstate(invalid="ignore"):
         finite = np.logical_and.reduceat(np.isfinite(cubics).all(axis=1), starts)
         size = np.maximum(
-            np.maximum(_ptp_at(x, starts), _ptp_at(y, starts)),
+            np.maximum(ptp_at(x, starts), ptp_at(y, starts)),
             np.maximum.reduceat(np.abs(cubics).max(axis=1), starts),
         )
     groups: dict[int, list[int]] = {}
@@ -90,25 +91,14 @@ def compact_paths(ds: list[str], block: int = 1 << 16) -> list[str]:
         if ok and s > 0:
             groups.setdefault(_decimals(s), []).append(i)
     for decimals, members in groups.items():
-        lo = 0
-        while lo < len(members):
-            hi, length = lo, 0
-            while hi < len(members) and length + len(ds[members[hi]]) <= block:
-                length += len(ds[members[hi]]) + 1
-                hi += 1
+        for lo, hi in runs([len(ds[i]) + 1 for i in members], block + 1):  # each text and a NUL
             # NUL is no part of a number: the texts come apart where they were joined
             chunk = members[lo:hi]
             for i, text in zip(
                 chunk, _rounded("\0".join(ds[i] for i in chunk), decimals).split("\0"), strict=True
             ):
                 out[i] = text
-            lo = hi
     return out
-
-
-def _ptp_at(values: np.ndarray, starts: np.ndarray) -> np.ndarray:
-    """Peak to peak of each block of ``(k, 4)`` rows starting at ``starts`` (exact: max - min)."""
-    return np.maximum.reduceat(values.max(axis=1), starts) - np.minimum.reduceat(values.min(axis=1), starts)
 
 
 def _pieces(d: str, size: int = 1 << 20) -> Iterator[str]:

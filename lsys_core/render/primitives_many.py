@@ -23,7 +23,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from lsys_core.geometry.shapes import shapes_arrays
+from lsys_core.geometry.shapes import ptp_at, shapes_arrays
 from lsys_core.render.primitives import TOLERANCE, chord_frame, primitive_of
 
 __all__ = ["Shape", "primitives"]
@@ -73,7 +73,7 @@ def primitives(ds: Sequence[str]) -> list[Shape | None]:
     closed = np.array(flags, dtype=bool)
     finite = np.logical_and.reduceat(np.isfinite(cubics).all(axis=1), starts)
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-        size = _ptp_at(cubics.real, starts) + _ptp_at(cubics.imag, starts)
+        size = ptp_at(cubics.real, starts) + ptp_at(cubics.imag, starts)
         tol = TOLERANCE * size
         keep = finite & (size > 0)
         seg_tol = np.repeat(tol, counts)
@@ -98,11 +98,6 @@ def primitives(ds: Sequence[str]) -> list[Shape | None]:
         assert a is not None
         out[cand[j]] = primitive_of(a[0], a[2])
     return out
-
-
-def _ptp_at(values: np.ndarray, starts: np.ndarray) -> np.ndarray:
-    """Peak to peak of each ``(k, 4)`` block of rows starting at ``starts`` (exact: max - min)."""
-    return np.maximum.reduceat(values.max(axis=1), starts) - np.minimum.reduceat(values.min(axis=1), starts)
 
 
 def _straight_bounds(

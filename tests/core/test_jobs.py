@@ -108,13 +108,13 @@ def test_step_clusters_solved_in_parts_and_batches_give_the_same_rules(restore_j
     parallel.set_jobs(1)
     whole = infer(grid)
     split = []
-    runs = linear._runs
+    runs = parallel.runs
     # every (d, s) cluster a part of its own and every step cluster a run of its own, as a
     # scene of millions of consecutive pairs has them, on three workers
     monkeypatch.setattr(linear, "_PART", 1)
     monkeypatch.setattr(linear, "_SPLIT", 0)
     monkeypatch.setattr(linear, "_BATCH", 1)
-    monkeypatch.setattr(linear, "_runs", lambda *a: split.append(runs(*a)) or split[-1])
+    monkeypatch.setattr(parallel, "runs", lambda *a: split.append(runs(*a)) or split[-1])
     parallel.set_jobs(3)
     parts = infer(grid)
     assert max(len(r) for r in split) >= 2
@@ -122,8 +122,7 @@ def test_step_clusters_solved_in_parts_and_batches_give_the_same_rules(restore_j
 
 
 def test_runs_cover_every_item_once_in_order() -> None:
-    from lsys_core.hierarchy.linear import _runs
-
+    _runs = parallel.runs
     assert _runs([], 10) == []
     assert _runs([5, 5], 10) == [(0, 2)]
     for sizes in ([300_000] * 5, [1, 900_000, 1, 1], [400_000, 1], [700_000] * 9, [3_000_000, 10, 10]):
