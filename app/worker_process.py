@@ -19,6 +19,7 @@ from typing import Any
 
 from lsys_core.cancel import CancelToken, Progress
 from lsys_core.errors import Cancelled, LsysError
+from lsys_core.parallel import switching_often
 
 __all__ = [
     "CANCEL_GRACE_S",
@@ -93,7 +94,8 @@ def _child_main(conn, compute: Compute, preload: tuple[str, ...]) -> None:
                     token.cancel()
 
         try:
-            reply = ("done", compute(msg[1], token, progress))
+            with switching_often():  # the process's threads share its interpreter (see the function)
+                reply = ("done", compute(msg[1], token, progress))
         except Cancelled:
             reply = ("cancelled",)
         except Exception as exc:

@@ -30,7 +30,7 @@ from lsys_core.cli.args import build_parser
 from lsys_core.cli.commands import Progress, run_command
 from lsys_core.errors import LsysError
 from lsys_core.io import OutputClosed
-from lsys_core.parallel import keep_freed_memory
+from lsys_core.parallel import keep_freed_memory, switching_often
 from lsys_core.quoting import printable
 
 __all__ = ["main", "run"]
@@ -66,7 +66,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     keep_freed_memory()  # the command's process is ours: reuse freed arrays (see the function)
     try:
-        return _run(args)
+        with switching_often():  # (see the function)
+            return _run(args)
     finally:
         gc.unfreeze()  # what the command froze (see commands.imports_frozen) is collected again
         _settle_stdout()

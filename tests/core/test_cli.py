@@ -117,7 +117,8 @@ def test_usage_error_exits_2() -> None:
 
 
 def test_main_in_process_leaves_the_garbage_collector_as_it_was(tmp_path) -> None:
-    """``infer`` imports with the collector paused and freezes the modules; ``main`` undoes both."""
+    """``infer`` imports with the collector paused and freezes the modules; ``main`` undoes both
+    (and gives back the interpreter's switch interval)."""
     import gc
 
     from lsys_core.cli import main
@@ -129,8 +130,10 @@ def test_main_in_process_leaves_the_garbage_collector_as_it_was(tmp_path) -> Non
         + "</svg>"
     )
     assert gc.isenabled()
+    interval = sys.getswitchinterval()
     assert main(["-q", "infer", str(src), "-o", str(tmp_path / "r.lsys")]) == 0
     assert gc.isenabled() and gc.get_freeze_count() == 0
+    assert sys.getswitchinterval() == interval
     gc.disable()
     try:
         assert main(["-q", "infer", str(src), "-o", str(tmp_path / "r2.lsys")]) == 0

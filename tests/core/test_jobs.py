@@ -121,6 +121,23 @@ def test_step_clusters_solved_in_parts_and_batches_give_the_same_rules(restore_j
     assert format_grammar(parts.grammar) == format_grammar(whole.grammar) and parts.log == whole.log
 
 
+def test_threads_switch_often_within_the_block_only() -> None:
+    """The interval is shortened inside the block (never lengthened) and restored after it, even on error."""
+    before = sys.getswitchinterval()
+    try:
+        sys.setswitchinterval(0.005)
+        with parallel.switching_often():
+            assert sys.getswitchinterval() == pytest.approx(parallel.SWITCH_INTERVAL, abs=1e-5)
+        assert sys.getswitchinterval() == pytest.approx(0.005, abs=1e-5)
+        sys.setswitchinterval(0.0002)
+        with pytest.raises(ValueError), parallel.switching_often():
+            assert sys.getswitchinterval() == pytest.approx(0.0002, abs=1e-5)
+            raise ValueError
+        assert sys.getswitchinterval() == pytest.approx(0.0002, abs=1e-5)
+    finally:
+        sys.setswitchinterval(before)
+
+
 def test_runs_cover_every_item_once_in_order() -> None:
     _runs = parallel.runs
     assert _runs([], 10) == []
