@@ -23,7 +23,8 @@ import numpy as np
 from lsys_core.hierarchy.candidates import Candidate
 from lsys_core.hierarchy.gain import Ledger
 from lsys_core.hierarchy.nodes import Nodes
-from lsys_core.hierarchy.select import Weights, importance_order, importance_terms, node_index
+from lsys_core.hierarchy.rivals import Rivals
+from lsys_core.hierarchy.select import Weights, importance_order, importance_terms
 from lsys_core.hierarchy.symbols import SymbolTable
 from lsys_core.memo import IdentityMemo
 
@@ -95,17 +96,17 @@ class LevelView:
         self.terms = importance_terms(self.cands)
         self._tested: IdentityMemo[Candidate, Candidate | None] = IdentityMemo()
         self._ceilings: IdentityMemo[Candidate, float] = IdentityMemo()
-        self._index: tuple[np.ndarray, np.ndarray] | None = None
+        self._rivals: Rivals | None = None
 
     def order(self, weights: Weights) -> tuple[np.ndarray, list[int]]:
         """:func:`~lsys_core.hierarchy.select.importance_order` of the candidates for ``weights``."""
         return importance_order(self.cands, weights, self.terms)
 
-    def index(self) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`~lsys_core.hierarchy.select.node_index` of the candidates (made once)."""
-        if self._index is None:
-            self._index = node_index(self.cands, len(self.ledger.nodes))
-        return self._index
+    def index(self) -> Rivals:
+        """The :class:`~lsys_core.hierarchy.rivals.Rivals` of the candidates (made once)."""
+        if self._rivals is None:
+            self._rivals = Rivals(self.cands, len(self.ledger.nodes))
+        return self._rivals
 
     def ceiling(self, c: Candidate) -> float:
         """:meth:`~lsys_core.hierarchy.gain.Ledger.ceiling` of ``c``, remembered."""

@@ -17,9 +17,9 @@ import numpy as np
 from lsys_core.hierarchy.candidates import BranchCandidate, Candidate, PairCandidate, SeqCandidate
 from lsys_core.hierarchy.gain import Ledger, group_reach, placement_error
 from lsys_core.hierarchy.nodes import Nodes
+from lsys_core.hierarchy.rivals import Rivals
 from lsys_core.hierarchy.snap import SHARE, plainer, snapped
 from lsys_core.settings import setting
-from lsys_core.sorting import sorted_unique
 
 __all__ = [
     "WEAK_COVER",
@@ -28,7 +28,6 @@ __all__ = [
     "choose",
     "importance_order",
     "importance_terms",
-    "node_index",
     "scores",
     "worthwhile",
 ]
@@ -211,7 +210,7 @@ def choose(
     ceiling: Callable[[Candidate], float] | None = None,
     *,
     order: tuple[np.ndarray, list[int]] | None = None,
-    index: Callable[[], tuple[np.ndarray, np.ndarray]] | None = None,
+    index: Callable[[], Rivals] | None = None,
 ) -> list[Candidate]:
     """The candidates to apply at this level, most important first (§5.4–§5.5).
 
@@ -230,10 +229,10 @@ def choose(
     lines (133) and the row of ticks (167).
 
     ``order`` (:func:`importance_order` of ``cands`` and ``weights``) and ``index`` (giving
-    :func:`node_index` of ``cands``) save computing them again.
+    the :class:`~lsys_core.hierarchy.rivals.Rivals` of ``cands``) save computing them again.
     """
     score, order_ = importance_order(cands, weights) if order is None else order
-    owners: tuple[np.ndarray, np.ndarray] | None = None
+    rivals: Rivals | None = None
     taken = np.zeros(n_nodes, bool)
     out: list[Candidate] = []
     k = 0
@@ -254,9 +253,9 @@ def choose(
             if taken[nodes].any():
                 continue
             if ceiling is not None:
-                if owners is None:
-                    owners = node_index(cands, n_nodes) if index is None else index()
-                c = _dominant(c, cands, owners, taken, worthwhile, ceiling)
+                if rivals is None:
+                    rivals = Rivals(cands, n_nodes) if index is None else index()
+                c = _dominant(c, cands, rivals, taken, worthwhile, ceiling)
                 nodes = c.nodes()
             taken[nodes] = True
             out.append(c)
@@ -272,26 +271,10 @@ DOMINANT = 4.0
 DOMINANT_BITS = 32.0
 
 
-def node_index(cands: list[Candidate], n_nodes: int) -> tuple[np.ndarray, np.ndarray]:
-    """The candidates on every node: ``owners[start[k]:start[k + 1]]`` are those on node ``k``.
-
-    Each node's candidates are listed once, in increasing order: one sort of the (node,
-    candidate) pairs packed into one integer (a ``np.unique`` per candidate took 0.5 s of a
-    50,052-leaf grid).
-    """
-    if not cands:
-        return np.zeros(0, np.int64), np.zeros(n_nodes + 1, np.int64)
-    nodes = [c.nodes() for c in cands]
-    flat = np.concatenate(nodes).astype(np.int64)
-    which = np.repeat(np.arange(len(cands), dtype=np.int64), [x.size for x in nodes])
-    node, owner = np.divmod(sorted_unique(flat * len(cands) + which), len(cands))
-    return owner, np.searchsorted(node, np.arange(n_nodes + 1))
-
-
 def _dominant(
     c: Candidate,
     cands: list[Candidate],
-    index: tuple[np.ndarray, np.ndarray],
+    rivals_of: Rivals,
     taken: np.ndarray,
     worthwhile: Callable[[Candidate], Candidate | None],
     ceiling: Callable[[Candidate], float],
@@ -301,11 +284,9 @@ def _dominant(
     Every rival counted saves more than ``c`` and more than :data:`DOMINANT_BITS` on its own;
     rivals are taken on disjoint nodes, most promising (highest ceiling) first.
     """
-    owners, start = index
     floor = max(c.gain, DOMINANT_BITS)
     need = max(DOMINANT * c.gain, c.gain + DOMINANT_BITS)
-    rivals = np.unique(np.concatenate([owners[start[k] : start[k + 1]] for k in np.unique(c.nodes())]))
-    bounds = [(ceiling(cands[i]), int(i)) for i in rivals.tolist()]
+    bounds = [(ceiling(cands[i]), i) for i in rivals_of.on(c.nodes()).tolist()]
     found: list[Candidate] = []
     used = np.zeros(0, np.int64)
     for bound, i in sorted(bounds, reverse=True):

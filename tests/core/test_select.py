@@ -117,7 +117,7 @@ def test_a_candidate_yields_to_rivals_that_together_save_far_more():
 
 
 def test_node_index_lists_each_nodes_candidates_once_in_order() -> None:
-    from lsys_core.hierarchy.select import node_index
+    from lsys_core.hierarchy.rivals import node_index
 
     class Cand:
         def __init__(self, nodes: np.ndarray) -> None:
@@ -135,3 +135,24 @@ def test_node_index_lists_each_nodes_candidates_once_in_order() -> None:
     assert start[-1] == owners.size
     empty_owners, empty_start = node_index([], 3)
     assert empty_owners.size == 0 and empty_start.tolist() == [0, 0, 0, 0]
+
+
+def test_rivals_by_scan_and_by_index_are_the_candidates_on_the_nodes() -> None:
+    from lsys_core.hierarchy.rivals import SCANS, Rivals
+
+    class Cand:
+        def __init__(self, nodes: np.ndarray) -> None:
+            self._nodes = nodes
+
+        def nodes(self) -> np.ndarray:
+            return self._nodes
+
+    rng = np.random.default_rng(5)
+    cands = [Cand(rng.integers(0, 60, rng.integers(1, 15))) for _ in range(200)]  # repeats within one
+    rivals = Rivals(cands, 64)
+    for q in range(3 * SCANS):  # the first SCANS by scanning, the rest from the index
+        asked = rng.integers(0, 64, rng.integers(0, 30) if q % 5 else 64)
+        want = [i for i, c in enumerate(cands) if np.isin(c.nodes(), asked).any()]
+        got = rivals.on(asked)
+        assert got.dtype == np.int64 and got.tolist() == want
+    assert Rivals([], 5).on(np.array([1, 2])).size == 0
