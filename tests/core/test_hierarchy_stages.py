@@ -63,6 +63,22 @@ def test_nodes_merge_replaces_groups_by_their_first_node() -> None:
     assert merged.center[2] == 15 and merged.radius[2] == 6  # circle around both
     assert merged.members[2].tolist() == [2, 1]
     assert nodes.first_members().tolist() == [0, 1, 2, 3]
+    assert merged.first_members().tolist() == [0, 3, 1]
+
+
+def test_first_members_is_each_nodes_smallest_element() -> None:
+    rng = np.random.default_rng(2)
+    members = tuple(rng.permutation(50)[: rng.integers(1, 7)] for _ in range(300))
+    n = len(members)
+    z = np.zeros(n, complex)
+    nodes = Nodes(np.zeros(n, np.int64), z + 1, z, z, np.ones(n), members, np.ones(n))
+    assert nodes.first_members().tolist() == [int(m.min()) for m in members]
+    assert (
+        Nodes(z[:0].real.astype(np.int64), z[:0], z[:0], z[:0], z[:0].real, (), z[:0].real)
+        .first_members()
+        .size
+        == 0
+    )
 
 
 # -- chains ------------------------------------------------------------------------------------
