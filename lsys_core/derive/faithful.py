@@ -141,18 +141,33 @@ def _greedy(target: np.ndarray, found: np.ndarray, ids: np.ndarray) -> np.ndarra
     The pairs of every point and its 8 nearest targets are taken in order of distance; the
     loop ends when every point has one (50,052 derived leaves: 0.27-0.57 -> 0.17-0.33 s).
     A vectorised greedy (:func:`lsys_core.hierarchy.flat.greedy_links`) took 0.53-0.70 s.
+
+    When every point has one strictly nearest target, a different one for each (a derivation
+    that reproduces its drawing), each point's first pair is its nearest target and nothing
+    has taken it: that is the matching, read off two neighbours per point without the loop
+    (50,052 derived leaves: 0.14 -> 0.045 s).
     """
     from scipy.spatial import cKDTree
 
-    k = min(8, target.size)
-    dist, near = cKDTree(np.column_stack([target.real, target.imag])).query(
-        np.column_stack([found.real, found.imag]), k=k
-    )
-    dist, near = dist.reshape(found.size, k), near.reshape(found.size, k)
+    tree = cKDTree(np.column_stack([target.real, target.imag]))
+    points = np.column_stack([found.real, found.imag])
+    if target.size >= 2 and found.size:
+        dist, near = tree.query(points, k=2)
+        if (dist[:, 1] > dist[:, 0]).all() and np.bincount(near[:, 0], minlength=target.size).max() <= 1:
+            return ids[near[:, 0]]
+    return _greedy_pairs(tree, target.size, points, ids)
+
+
+def _greedy_pairs(tree, n_targets: int, points: np.ndarray, ids: np.ndarray) -> np.ndarray:
+    """:func:`_greedy` by taking the pairs of every point and its 8 nearest targets in order of distance."""
+    k = min(8, n_targets)
+    dist, near = tree.query(points, k=k)
+    n = points.shape[0]
+    dist, near = dist.reshape(n, k), near.reshape(n, k)
     rows, cols = np.divmod(np.argsort(dist, axis=None, kind="stable"), k)
-    result = np.full(found.size, -1, np.int64)
-    taken = np.zeros(target.size, bool)
-    left = found.size  # once every point has its target, the rest of the pairs change nothing
+    result = np.full(n, -1, np.int64)
+    taken = np.zeros(n_targets, bool)
+    left = n  # once every point has its target, the rest of the pairs change nothing
     for i, t in zip(rows.tolist(), near[rows, cols].tolist(), strict=True):
         if result[i] < 0 and not taken[t]:
             result[i], taken[t] = t, True

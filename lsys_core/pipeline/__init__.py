@@ -25,7 +25,15 @@ from lsys_core.hierarchy.explain import explained_share, placed_by_repetition
 from lsys_core.hierarchy.postprocess import simplify
 from lsys_core.hierarchy.rules import Hierarchy, Tolerance, Weights, build_hierarchy
 from lsys_core.hierarchy.snap import SHARE
-from lsys_core.report import InferenceResult, as_instancing, deviation, measurer, reproduction_error
+from lsys_core.report import (
+    InferenceResult,
+    Matched,
+    as_instancing,
+    deviation,
+    displacement,
+    matched_poses,
+    measurer,
+)
 from lsys_core.settings import RELAXED, InferenceSettings
 from lsys_core.svg.model import Scene
 
@@ -147,7 +155,7 @@ def rules_from_analysis(
     # stretched copies are drawn as their base with a stretch: the grammar does not list them
     copies = inst.stretch_base if inst.stretch_base is not None else np.full(len(inst.terminals), -1)
     drawn = tuple(t for t, c in zip(inst.terminals, copies, strict=True) if c < 0)
-    best: tuple[Grammar, Hierarchy, float, float, Drawing] | None = None
+    best: tuple[Grammar, Hierarchy, float, float, Drawing, Matched] | None = None
     by_hand = bool(np.any(shape_dev > EXACT_PLACEMENT * diag))  # beyond rounding: see _tries
     for tol in _tries(settings, symmetrizing, len(scene.elements), by_hand):
         check(cancel)
@@ -179,19 +187,20 @@ def rules_from_analysis(
         t = time.perf_counter()
         grammar = simplify(Grammar(drawn, tuple(hier.rules), hier.axiom, scene.viewbox, scene.size))
         drawing = as_instancing(derive(grammar, limit=max(10 * len(scene.elements), 1000)), inst)
-        error = deviation(inst, sizes, drawing, shape_dev, limit, measure)
+        matched = matched_poses(inst, sizes, drawing)
+        error = deviation(inst, sizes, matched, shape_dev, limit, measure)
         bits = grammar_bits(grammar, prec)
         stages["postprocess"] = stages.get("postprocess", 0.0) + time.perf_counter() - t
         # The first try is always kept; relaxed ones must stay within the tolerance and be shorter.
         if best is None or (error <= limit and (bits, error) < (best[3], best[2])):
-            best = (grammar, hier, error, bits, drawing)
+            best = (grammar, hier, error, bits, drawing, matched)
         if hier.closed and not symmetrizing:
             break  # every element is explained by repetitions: no need to relax
         if hier.levels == 0 and len(scene.elements) > LARGE_SCENE:
             break  # nothing repeats at all in a large scene: relaxing would only find chance
     assert best is not None  # _tries is never empty and the first try is always kept
-    grammar, hier, error, bits, drawing = best
-    stages["reproduction_error"] = reproduction_error(inst, sizes, drawing) / diag
+    grammar, hier, error, bits, drawing, matched = best
+    stages["reproduction_error"] = displacement(inst, sizes, matched) / diag
     t = time.perf_counter()
     grammar = paint_like_input(grammar, scene, inst)
     stages["paint"] = time.perf_counter() - t

@@ -341,20 +341,27 @@ def test_matching_from_the_nearest_instances_is_the_whole_matrix_matching() -> N
     assert shortcuts >= 4  # the shortcut is taken where the match is clear
 
 
-@pytest.mark.parametrize("case", ["jitter", "ties", "exact", "few"])
-def test_greedy_matching_takes_the_nearest_pairs_first(case: str) -> None:
+@pytest.mark.parametrize("case", ["jitter", "ties", "exact", "close", "few"])
+def test_greedy_matching_takes_the_nearest_pairs_first(case: str, monkeypatch: pytest.MonkeyPatch) -> None:
     """The greedy matching of many instances: every pair of a point and one of its 8 nearest
-    targets, in order of distance (ties in order of point, then neighbour rank), as the plain loop takes them."""
+    targets, in order of distance (ties in order of point, then neighbour rank), as the plain loop takes them.
+    Points each nearest a different target (exact or close copies) are matched without the loop."""
     from scipy.spatial import cKDTree
 
+    from lsys_core.derive import faithful
     from lsys_core.derive.faithful import _greedy
+
+    pairs = []
+    loop = faithful._greedy_pairs
+    monkeypatch.setattr(faithful, "_greedy_pairs", lambda *a: pairs.append(1) or loop(*a))
 
     rng = np.random.default_rng(len(case))
     n = 5 if case == "few" else 3_000
     target = rng.uniform(0, 100, n) + 1j * rng.uniform(0, 100, n)
     if case == "ties":
         target = np.round(target / 10) * 10  # many points at one place: equal distances
-    found = target[rng.permutation(n)] + (0 if case == "exact" else rng.normal(0, 2, n) * (1 + 1j))
+    noise = {"exact": 0.0, "close": 1e-3}.get(case, 2.0)
+    found = target[rng.permutation(n)] + rng.normal(0, noise, n) * (1 + 1j)
     ids = np.arange(n) + 7
     k = min(8, n)
     dist, near = cKDTree(np.column_stack([target.real, target.imag])).query(
@@ -368,3 +375,4 @@ def test_greedy_matching_takes_the_nearest_pairs_first(case: str) -> None:
             want[i], taken[near[i, j]] = near[i, j], True
     want[want < 0] = np.flatnonzero(~taken)[: int((want < 0).sum())]
     assert np.array_equal(_greedy(target, found, ids), ids[want])
+    assert bool(pairs) == (case in ("jitter", "ties")), pairs

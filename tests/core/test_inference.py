@@ -7,7 +7,8 @@ import pytest
 
 from lsys_core.derive.derivation import derive
 from lsys_core.grammar import Symbol, Turtle, format_grammar, parse_grammar
-from lsys_core.pipeline import InferenceSettings, infer, reproduction_error, symmetrize
+from lsys_core.pipeline import InferenceSettings, infer, symmetrize
+from lsys_core.report import reproduction_error
 
 from .scenes import HOOK, LEAF, place, pose, scene, turtle_sequence
 
