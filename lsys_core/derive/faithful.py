@@ -21,6 +21,7 @@ what the elements' paint needs:
 from __future__ import annotations
 
 import re
+from collections import Counter
 from dataclasses import replace
 
 import numpy as np
@@ -276,6 +277,16 @@ def _named(names: dict[str, str], css: str) -> str:
     return names[css]
 
 
+def _most_common(styles: list[str]) -> str:
+    """The most common of ``styles``, the least of them in string order among equally common ones.
+
+    What ``np.unique(..., return_counts=True)`` and the first largest count give, by counting
+    (50,052 instances of one style: 15 -> 3 ms).
+    """
+    counts = Counter(map(str, styles))
+    return min(counts.items(), key=lambda kv: (-kv[1], kv[0]))[0]
+
+
 def _fit_styles(g: Grammar, styles: np.ndarray, trace: Trace, edits: dict) -> tuple[Grammar, tuple | None]:
     """Choose base styles, occurrence paints and a ``paint:`` table; record paints in ``edits``."""
     n = styles.size
@@ -285,13 +296,19 @@ def _fit_styles(g: Grammar, styles: np.ndarray, trace: Trace, edits: dict) -> tu
     for s in np.unique(trace.slot).tolist():
         owner, ci, mi = trace.slots[s]
         slot_terms[s] = _module(g, owner, ci, mi).name
-    # Base style of each terminal: the most common among its instances.
+    # Base style of each terminal: the most common among its instances (ties: the least, as
+    # ``np.unique`` sorts them); the instances grouped by terminal with one stable sort
+    index = {t.name: k for k, t in enumerate(g.terminals)}
+    term_of_slot = np.full(len(trace.slots), len(g.terminals), np.int64)
+    for s, name in slot_terms.items():
+        term_of_slot[s] = index.get(name, len(g.terminals))
+    term = term_of_slot[trace.slot]
+    by_term = np.argsort(term, kind="stable")
+    bounds = np.searchsorted(term[by_term], np.arange(len(g.terminals) + 1))
     base = {}
-    for t in g.terminals:
-        mine = [i for i, s in enumerate(trace.slot.tolist()) if slot_terms[s] == t.name]
-        if mine:
-            vals, counts = np.unique(styles[mine].astype(str), return_counts=True)
-            base[t.name] = str(vals[np.argmax(counts)])
+    for k, t in enumerate(g.terminals):
+        if bounds[k + 1] > bounds[k]:
+            base[t.name] = _most_common(styles[by_term[bounds[k] : bounds[k + 1]]].tolist())
     g = replace(g, terminals=tuple(replace(t, style=base.get(t.name, t.style)) for t in g.terminals))
     names: dict[str, str] = {}
     table: list[str | None] = [None] * n
@@ -299,7 +316,7 @@ def _fit_styles(g: Grammar, styles: np.ndarray, trace: Trace, edits: dict) -> tu
     for s, term in slot_terms.items():
         sel = np.flatnonzero(trace.slot == s)
         own = base.get(term, "")
-        distinct = list(dict.fromkeys(str(v) for v in styles[sel].tolist()))
+        distinct = list(dict.fromkeys(map(str, styles[sel].tolist())))
         if len(distinct) == 1:
             if distinct[0] != own:
                 edits.setdefault(trace.slots[s], {})["style"] = _named(names, distinct[0])

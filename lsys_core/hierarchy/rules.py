@@ -369,9 +369,10 @@ def _duplicates(table: SymbolTable, nodes: Nodes) -> list[Candidate]:
     """
     sym, a, b = nodes.sym, nodes.a, nodes.b
     q = np.maximum(table.sizes[sym] * 1e-6, 1e-9)
-    key = np.column_stack(
-        [sym, np.round(b.real / q), np.round(b.imag / q), np.round(a.real / 1e-6), np.round(a.imag / 1e-6)]
-    )
+    x, y = np.round(b.real / q), np.round(b.imag / q)
+    if not _shared_places(x, y):
+        return []  # no two nodes at one place: no stacks (the usual case)
+    key = np.column_stack([sym, x, y, np.round(a.real / 1e-6), np.round(a.imag / 1e-6)])
     _, inv, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
     inv = inv.ravel()
     stacks: dict[int, list[np.ndarray]] = {}
@@ -382,6 +383,17 @@ def _duplicates(table: SymbolTable, nodes: Nodes) -> list[Candidate]:
         SeqCandidate(space=(s, s), groups=Groups.of(groups), h=1.0, phi=1.0, l=1.0, A=1 + 0j, B=0j)
         for s, groups in stacks.items()
     ]
+
+
+def _shared_places(x: np.ndarray, y: np.ndarray) -> bool:
+    """Whether two entries have equal ``x`` and equal ``y``: a sort of both, neighbours compared.
+
+    :func:`_duplicates` asks it before grouping whole poses (``np.unique`` of the five columns
+    by rows took 51 ms of a 50,052-leaf grid, this 7 ms).
+    """
+    order = np.lexsort((y, x))
+    xs, ys = x[order], y[order]
+    return bool(np.any((xs[1:] == xs[:-1]) & (ys[1:] == ys[:-1])))
 
 
 def _same(ledger: Ledger) -> Ledger:

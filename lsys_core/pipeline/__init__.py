@@ -17,7 +17,7 @@ from dataclasses import replace
 import numpy as np
 
 from lsys_core.cancel import CancelToken, Progress, check, report
-from lsys_core.derive.derivation import derive
+from lsys_core.derive.derivation import Trace, derive, derive_traced
 from lsys_core.derive.model import Drawing
 from lsys_core.grammar.model import Grammar
 from lsys_core.hierarchy.describe import flat_bits, grammar_bits
@@ -44,6 +44,7 @@ from .analysis import (
     Analysis,
     analyse,
     paint_like_input,
+    paint_limit,
 )
 
 __all__ = [
@@ -155,7 +156,7 @@ def rules_from_analysis(
     # stretched copies are drawn as their base with a stretch: the grammar does not list them
     copies = inst.stretch_base if inst.stretch_base is not None else np.full(len(inst.terminals), -1)
     drawn = tuple(t for t, c in zip(inst.terminals, copies, strict=True) if c < 0)
-    best: tuple[Grammar, Hierarchy, float, float, Drawing, Matched] | None = None
+    best: tuple[Grammar, Hierarchy, float, float, Drawing, Matched, tuple[Drawing, Trace]] | None = None
     by_hand = bool(np.any(shape_dev > EXACT_PLACEMENT * diag))  # beyond rounding: see _tries
     for tol in _tries(settings, symmetrizing, len(scene.elements), by_hand):
         check(cancel)
@@ -186,23 +187,24 @@ def rules_from_analysis(
         )
         t = time.perf_counter()
         grammar = simplify(Grammar(drawn, tuple(hier.rules), hier.axiom, scene.viewbox, scene.size))
-        drawing = as_instancing(derive(grammar, limit=max(10 * len(scene.elements), 1000)), inst)
+        derived = derive_traced(grammar, limit=paint_limit(scene))  # painting the kept one reads it too
+        drawing = as_instancing(derived[0], inst)
         matched = matched_poses(inst, sizes, drawing)
         error = deviation(inst, sizes, matched, shape_dev, limit, measure)
         bits = grammar_bits(grammar, prec)
         stages["postprocess"] = stages.get("postprocess", 0.0) + time.perf_counter() - t
         # The first try is always kept; relaxed ones must stay within the tolerance and be shorter.
         if best is None or (error <= limit and (bits, error) < (best[3], best[2])):
-            best = (grammar, hier, error, bits, drawing, matched)
+            best = (grammar, hier, error, bits, drawing, matched, derived)
         if hier.closed and not symmetrizing:
             break  # every element is explained by repetitions: no need to relax
         if hier.levels == 0 and len(scene.elements) > LARGE_SCENE:
             break  # nothing repeats at all in a large scene: relaxing would only find chance
     assert best is not None  # _tries is never empty and the first try is always kept
-    grammar, hier, error, bits, drawing, matched = best
+    grammar, hier, error, bits, drawing, matched, derived = best
     stages["reproduction_error"] = displacement(inst, sizes, matched) / diag
     t = time.perf_counter()
-    grammar = paint_like_input(grammar, scene, inst)
+    grammar = paint_like_input(grammar, scene, inst, derived)
     stages["paint"] = time.perf_counter() - t
     report(progress, "done", 1.0)
     segments = np.array([e.cubics.shape[0] for e in scene.elements])

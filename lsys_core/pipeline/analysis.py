@@ -15,8 +15,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from lsys_core.cancel import CancelToken, Progress, check
-from lsys_core.derive.derivation import derive_traced
+from lsys_core.derive.derivation import Trace, derive_traced
 from lsys_core.derive.faithful import fit_paint, match_instances
+from lsys_core.derive.model import Drawing
 from lsys_core.errors import InferenceError
 from lsys_core.grammar.model import Grammar
 from lsys_core.hierarchy.cache import LevelCache
@@ -78,16 +79,19 @@ def _instancing(scene: Scene, settings: InferenceSettings, tolerance: float, can
     return stretch_families(scene, inst, tolerance)
 
 
-def paint_like_input(grammar: Grammar, scene: Scene, inst: Instancing) -> Grammar:
+def paint_like_input(
+    grammar: Grammar, scene: Scene, inst: Instancing, derived: tuple[Drawing, Trace] | None = None
+) -> Grammar:
     """Give an inferred grammar the input's names, styles, paint order, defs and verbatim content.
 
-    The grammar is derived once
+    The grammar is derived once (``derived``: its :func:`~lsys_core.derive.derivation.derive_traced`
+    with the limit :func:`paint_limit`, if already made)
     and each instance matched to its element (:func:`~lsys_core.derive.faithful.fit_paint`);
     the scene's ``defs`` and verbatim content are carried over, each verbatim item placed
     after the instances of the elements that precede it in the document.
     """
     orders = np.array([e.order if e.order >= 0 else i for i, e in enumerate(scene.elements)], float)
-    drawing, trace = derive_traced(grammar, limit=max(10 * len(scene.elements), 1000))
+    drawing, trace = derived if derived is not None else derive_traced(grammar, limit=paint_limit(scene))
     names = [inst.terminals[g].name for g in inst.group]
     mapped = as_instancing(drawing, inst)  # stretched copies by the terminals of their elements
     match = match_instances(
@@ -100,6 +104,11 @@ def paint_like_input(grammar: Grammar, scene: Scene, inst: Instancing) -> Gramma
         for v in sorted(scene.verbatim, key=lambda v: v.order)
     )
     return replace(grammar, defs=scene.defs, verbatim=verbatim)
+
+
+def paint_limit(scene: Scene) -> int:
+    """The instance limit :func:`paint_like_input` derives a grammar of ``scene`` with."""
+    return max(10 * len(scene.elements), 1000)
 
 
 @dataclass(frozen=True, eq=False)

@@ -376,3 +376,15 @@ def test_greedy_matching_takes_the_nearest_pairs_first(case: str, monkeypatch: p
     want[want < 0] = np.flatnonzero(~taken)[: int((want < 0).sum())]
     assert np.array_equal(_greedy(target, found, ids), ids[want])
     assert bool(pairs) == (case in ("jitter", "ties")), pairs
+
+
+def test_most_common_style_is_what_unique_counts_give() -> None:
+    from lsys_core.derive.faithful import _most_common
+
+    rng = np.random.default_rng(9)
+    pool = ["fill:red", "fill:blue", "stroke:#000", "", "fill:red;opacity:0.5", "é"]
+    for n in (1, 2, 3, 7, 50):
+        for _ in range(20):
+            styles = [pool[i] for i in rng.integers(0, len(pool), n)]
+            vals, counts = np.unique(np.array(styles, object).astype(str), return_counts=True)
+            assert _most_common(styles) == str(vals[np.argmax(counts)])

@@ -214,3 +214,31 @@ def test_candidate_holds_its_groups_flat_and_renumbers_them() -> None:
     moved = cand.remapped(np.array([10, 11, 12, 13, 14]))
     assert [g.tolist() for g in moved.groups] == [[14, 11, 12], [10, 13]]
     assert [g.tolist() for g in cand.groups] == [[4, 1, 2], [0, 3]]  # the original is untouched
+
+
+def test_shared_places_is_whether_two_entries_are_equal_in_both() -> None:
+    from lsys_core.hierarchy.rules import _shared_places
+
+    rng = np.random.default_rng(4)
+    for n in (0, 1, 2, 5, 40, 300):
+        for spread in (3, 30, 10**6):
+            x = rng.integers(0, spread, n).astype(float)
+            y = rng.integers(0, spread, n).astype(float)
+            want = np.unique(np.column_stack([x, y]), axis=0).shape[0] < n
+            assert _shared_places(x, y) == want
+    assert _shared_places(np.array([0.0, -0.0]), np.array([1.0, 1.0]))  # as ``np.unique`` groups them
+    assert not _shared_places(np.array([np.nan, np.nan]), np.array([1.0, 1.0]))
+
+
+def test_duplicates_stacks_copies_drawn_at_one_pose() -> None:
+    from lsys_core.hierarchy.rules import _duplicates
+    from lsys_core.hierarchy.symbols import SymbolTable
+
+    table = SymbolTable(["A", "B"], np.ones(2), np.eye(2))
+    b = np.array([0, 5, 0, 5, 0, 9], complex)
+    a = np.array([1, 1, 1, 1j, 1, 1], complex)
+    sym = np.array([0, 0, 0, 0, 1, 0])
+    nodes = Nodes.of_elements(sym, a, b, b, np.ones(6))
+    got = _duplicates(table, nodes)
+    assert [c.groups.nodes.tolist() for c in got] == [[0, 2]]  # same place and turn, same symbol
+    assert _duplicates(table, Nodes.of_elements(sym[:2], a[:2], b[:2], b[:2], np.ones(2))) == []
