@@ -2,8 +2,8 @@
 
 The text is classified byte by byte with a lookup table; number boundaries (``1-2``, ``1.5.5``,
 ``1e-3``) follow from shifted boolean arrays, malformed numbers (``1e``, ``.``, ``-``) are found
-with a few gathers, and the values are read by numpy's C parser from a copy of the text in which
-every token is separated by a space (correctly rounded, like :func:`float`).  The text is processed
+with a few gathers, and the values are read with whole-array operations (:mod:`.decimals`,
+correctly rounded, like :func:`float`).  The text is processed
 in chunks of about a megabyte cut at separators, so temporary memory is bounded whatever the length
 (one chunk per worker at a time: :func:`lsys_core.parallel.jobs`); work is linear in the length and
 the result holds three numbers per token.
@@ -18,6 +18,7 @@ from typing import NamedTuple
 import numpy as np
 
 from lsys_core.errors import LimitError
+from lsys_core.geometry.decimals import read_decimals
 from lsys_core.parallel import jobs, pmap
 
 __all__ = ["COMMAND_LETTERS", "Lexed", "lex", "numbers_from_text"]
@@ -110,7 +111,7 @@ def lex(
     pieces = list(itertools.pairwise(bounds))
     parts: list[tuple[np.ndarray, ...]] = []
     count = 0
-    step = jobs()  # chunks lexed at once, one a worker (numpy's parsers release the GIL)
+    step = jobs()  # chunks lexed at once, one a worker (the array operations release the GIL)
     for first in range(0, len(pieces), step):
         batch = pieces[first : first + step]
         for (a, _), (vals, starts, lets, lpos, errs) in zip(
@@ -233,7 +234,7 @@ def _lex_chunk(b: np.ndarray, letters: bool):
         numeric = numeric & ~bad[np.maximum(tok, 0)]
         starts, ends = starts[~bad], ends[~bad]
     lpos = np.flatnonzero(cls == _LETTER)
-    values = _values(b, numeric, starts, ends, apart=not prev_num[starts].any())
+    values = _values(b, numeric, starts, ends)
     return values, starts.astype(np.int64), b[lpos], lpos.astype(np.int64), errors.astype(np.int64)
 
 
@@ -262,29 +263,6 @@ def _malformed(cls, starts, ends) -> np.ndarray:
     return bad
 
 
-def _values(
-    b: np.ndarray, numeric: np.ndarray, starts: np.ndarray, ends: np.ndarray, apart: bool = False
-) -> np.ndarray:
-    """Read the token values with numpy's text parser from a space-separated copy of the chunk.
-
-    ``apart``: no token starts right after a number character (no ``1-2`` or ``1.5.5``), so
-    every other character can simply become a space (6 of the 35 ms a megabyte of path data
-    took to lex).
-    """
-    if starts.size == 0:
-        return np.zeros(0)
-    if apart:
-        buf = np.where(numeric, b, np.uint8(ord(" ")))
-    else:
-        # Every number character moves right by the number of tokens started at or before it,
-        # which puts one space before each token.
-        begins = np.zeros(b.size, dtype=np.int32)
-        begins[starts] = 1
-        pos = np.flatnonzero(numeric)
-        buf = np.full(b.size + starts.size, ord(" "), dtype=np.uint8)
-        buf[pos + np.cumsum(begins, dtype=np.int32)[pos]] = b[pos]
-    values = np.fromstring(buf.tobytes(), dtype=float, sep=" ")
-    if values.size != starts.size:  # cannot happen for validated tokens; keep the slow, sure way
-        raw = b.tobytes()
-        values = np.array([float(raw[s:e]) for s, e in zip(starts.tolist(), ends.tolist(), strict=True)])
-    return values
+def _values(b: np.ndarray, numeric: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """Read the token values (:func:`~lsys_core.geometry.decimals.read_decimals`)."""
+    return read_decimals(b, numeric, starts, ends)

@@ -256,20 +256,3 @@ def test_the_short_path_lexes_like_the_vectorised_one(tokens, letters):
         return
     for got, want in zip(quick, whole, strict=True):
         assert np.array_equal(got, want), text
-
-
-@settings(max_examples=300, deadline=None)
-@given(st.lists(st.tuples(st.one_of(_TOKENS, _COMMAND), _SEPS), max_size=30))
-def test_numbers_read_alike_with_and_without_blanking_the_separators(tokens):
-    import lsys_core.geometry.numbers as numbers
-
-    text = " ".join(t + s for t, s in tokens)
-    fast = numbers._lex_chunk(np.frombuffer(text.encode(), np.uint8), True)
-    values = numbers._values
-    try:  # every chunk read the general way (characters moved apart)
-        numbers._values = lambda b, numeric, starts, ends, apart=False: values(b, numeric, starts, ends)
-        slow = numbers._lex_chunk(np.frombuffer(text.encode(), np.uint8), True)
-    finally:
-        numbers._values = values
-    for got, want in zip(fast, slow, strict=True):
-        assert np.array_equal(got, want) and np.array_equal(np.signbit(got), np.signbit(want)), text
