@@ -69,7 +69,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         with switching_often():  # (see the function)
             return _run(args)
     finally:
-        gc.unfreeze()  # what the command froze (see commands.imports_frozen) is collected again
+        gc.unfreeze()  # what the command froze (see commands.frozen_after) is collected again
         _settle_stdout()
 
 

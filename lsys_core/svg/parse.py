@@ -152,8 +152,7 @@ def parse_svg(
     verbatim = tuple(
         Verbatim(r.order, r.xml, r.what) for r in reader.records if isinstance(r, VerbatimRecord)
     )
-    reader.records.clear()  # their paths now live in the elements (the reader is in a cycle)
-    return Scene(
+    scene = Scene(
         elements=tuple(elements),
         viewbox=viewbox,
         size=size,
@@ -162,6 +161,11 @@ def parse_svg(
         defs=reader.resources.markup(),
         verbatim=verbatim,
     )
+    # The reader is in reference cycles (its definitions call back into it): emptied, it and the
+    # document's tree are freed here, not by a later collection (41 ms of the cyclic collector,
+    # and their memory held for seconds, in the inference of a 50,052-leaf grid).
+    reader.__dict__.clear()
+    return scene
 
 
 def _root_context(reader: Reader, root) -> tuple:
