@@ -25,7 +25,7 @@ from lsys_core.quoting import quote_name
 from lsys_core.svg.model import Element, Scene
 from lsys_core.svg.style import DEFAULT_FONT_SIZE, font_size_px
 from lsys_core.svg.tree import Tree, local_name, shown
-from lsys_core.svg.uses import check_expansion, has_use
+from lsys_core.svg.uses import check_expansion
 from lsys_core.svg.values import IDENTITY, Viewport, parse_length, parse_viewbox, to_user, viewbox_transform
 from lsys_core.svg.walk import Ctx, Reader, ShapeRecord, VerbatimRecord
 from lsys_core.svg.xmlsafe import (
@@ -126,7 +126,7 @@ def parse_svg(
             shown_tag = f"<{tag}>" if tag.isprintable() and tag.isascii() else shown(tag)
             raise SvgError(f"not an SVG: {name}: the root element is {shown_tag}, not <svg>")
         tree = Tree(root)
-        if has_use(root):  # without, the drawing is part of the tree, read within these limits
+        if tree.of_kind("use"):  # without, the drawing is part of the tree, read within these limits
             check_expansion(tree, max_elements, max_depth, name)
         sys.setrecursionlimit(max(old_limit, 8 * max_depth + 1000))
         reader = Reader(tree, name, max_elements, max_depth)

@@ -72,10 +72,17 @@ class Tree:
         self.root = root
         self._links: tuple[dict[int, ET.Element], dict[int, ET.Element], dict[int, ET.Element]] | None = None
         self.ids: dict[str, ET.Element] = {}
+        self._kinds: dict[object, list[ET.Element]] = {}  # elements by tag, in document order
+        kinds = self._kinds
         for el in root.iter():  # document order: the first of duplicated ids wins
             el_id = el.get("id")
             if el_id is not None and el_id not in self.ids:
                 self.ids[el_id] = el
+            same = kinds.get(el.tag)
+            if same is None:
+                kinds[el.tag] = [el]
+            else:
+                same.append(el)
 
     def _linked(self) -> tuple[dict[int, ET.Element], dict[int, ET.Element], dict[int, ET.Element]]:
         """The parent, previous and following sibling of each element, by ``id``."""
@@ -115,14 +122,14 @@ class Tree:
     def of_kind(self, tag: str) -> list[ET.Element]:
         """The elements whose SVG local name is ``tag``, in document order.
 
-        Found by ElementTree's own search (a few milliseconds for 50,000 elements, where asking
-        every element for its local name took 20), unless the document writes the tag both with
-        and without the SVG namespace.
+        Sorted by tag in the one pass that finds the ids (3 ms for 50,052 elements, where each
+        search of ElementTree's own for a tag took 8: six of them, 50 ms), unless the document
+        writes the tag both with and without the SVG namespace.
         """
-        svg, plain = list(self.root.iter(SVG_NS + tag)), list(self.root.iter(tag))
+        svg, plain = self._kinds.get(SVG_NS + tag, []), self._kinds.get(tag, [])
         if svg and plain:
             return [el for el in self.root.iter() if el.tag in (tag, SVG_NS + tag)]
-        return svg or plain
+        return list(svg or plain)
 
     @staticmethod
     def tag(el: ET.Element) -> str | None:
