@@ -154,3 +154,45 @@ def test_elements_of_a_kind_in_document_order_with_and_without_the_namespace():
         "path[3]",
         "path[4]",
     ]
+
+
+def _names_one_by_one(tree) -> dict[int, str]:
+    """The names as the walk gave them element by element (the reference of ``source_names``)."""
+    from lsys_core.svg.records import SHAPES
+    from lsys_core.svg.tree import SVG_NS, shown
+
+    named = {tag: tag for tag in (*SHAPES, "use")}
+    named.update({SVG_NS + tag: tag for tag in named})
+    counts = dict.fromkeys(named.values(), 0)
+    names: dict[int, str] = {}
+    for el in tree.root.iter():
+        tag = named.get(el.tag)
+        if tag is None:
+            continue
+        el_id = el.get("id")
+        if el_id:
+            names[id(el)] = (
+                f"{tag}#{el_id}" if el_id.isprintable() and ">" not in el_id else f"{tag}#{shown(el_id)}"
+            )
+        else:
+            names[id(el)] = f"{tag}[{counts[tag]}]"
+        counts[tag] += 1
+    return names
+
+
+def test_source_names_kind_by_kind_are_those_named_one_by_one():
+    import xml.etree.ElementTree as ET
+
+    from lsys_core.svg.records import source_names
+    from lsys_core.svg.tree import Tree
+
+    text = (
+        '<svg xmlns="http://www.w3.org/2000/svg" xmlns:s="http://www.w3.org/2000/svg">'
+        '<path/><rect id="r"/><g><path id="a&gt;b"/><s:path/><rect/><use id="u&#10;x"/></g>'
+        '<circle/><circle id=""/><path xmlns="" id="plain"/><path xmlns=""/>'
+        '<defs><polygon/><ellipse id="e"/></defs><line/><polyline/><use/></svg>'
+    )
+    tree = Tree(ET.fromstring(text))
+    assert source_names(tree) == _names_one_by_one(tree)
+    many = Tree(ET.fromstring("<svg>" + "<path/>" * 50 + '<path id="x"/>' + "<rect/>" * 3 + "</svg>"))
+    assert source_names(many) == _names_one_by_one(many)
