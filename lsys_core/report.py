@@ -14,8 +14,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial import cKDTree
 
-from lsys_core.geometry.kdtree import cKDTree
 from lsys_core.grammar.model import Grammar
 from lsys_core.instancing.model import Instancing
 from lsys_core.svg.model import Scene

@@ -8,9 +8,9 @@ first scene's bounding-box diagonal, and the spread of nearest-neighbour spacing
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from lsys_core.derive.model import Drawing
-from lsys_core.geometry.kdtree import cKDTree
 from lsys_core.svg.model import Scene
 
 __all__ = ["assert_scenes_close", "drawing_scene", "hausdorff_rel", "regularity", "scene_points"]

@@ -121,7 +121,7 @@ def _clear_nearest(
     n = eb.size
     if n <= 2 * _NEAREST:
         return None
-    from lsys_core.geometry.kdtree import cKDTree
+    from scipy.spatial import cKDTree
 
     dist, near = cKDTree(np.column_stack([b.real, b.imag])).query(
         np.column_stack([eb.real, eb.imag]), k=_NEAREST
@@ -148,7 +148,7 @@ def _greedy(target: np.ndarray, found: np.ndarray, ids: np.ndarray) -> np.ndarra
     has taken it: that is the matching, read off two neighbours per point without the loop
     (50,052 derived leaves: 0.14 -> 0.045 s).
     """
-    from lsys_core.geometry.kdtree import cKDTree
+    from scipy.spatial import cKDTree
 
     tree = cKDTree(np.column_stack([target.real, target.imag]))
     points = np.column_stack([found.real, found.imag])

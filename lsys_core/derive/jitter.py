@@ -41,7 +41,7 @@ def _nearest_gap(points: np.ndarray) -> np.ndarray:
     """Return each point's distance to its nearest other point (0 when it is alone)."""
     if points.size < 2:
         return np.zeros(points.size)
-    from lsys_core.geometry.kdtree import cKDTree
+    from scipy.spatial import cKDTree
 
     xy = np.column_stack([points.real, points.imag])
     dist, _ = cKDTree(xy).query(xy, k=2)

@@ -11,9 +11,9 @@ are expected pre-scaled so that the bandwidth is 1 in every dimension.
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from lsys_core import parallel
-from lsys_core.geometry.kdtree import cKDTree
 from lsys_core.sorting import sorted_unique, stable_argsort
 
 __all__ = ["RANK", "group_indices", "mean_shift", "rank_order", "ranked_mean_shift", "spread"]

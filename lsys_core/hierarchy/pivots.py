@@ -24,8 +24,8 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+from scipy.spatial import cKDTree
 
-from lsys_core.geometry.kdtree import cKDTree
 from lsys_core.hierarchy.clustering import group_indices, mean_shift
 from lsys_core.instancing.model import Instancing
 

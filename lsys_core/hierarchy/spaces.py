@@ -12,8 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
-from lsys_core.geometry.kdtree import cKDTree
 from lsys_core.parallel import jobs
 from lsys_core.sorting import sorted_unique
 

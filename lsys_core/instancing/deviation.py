@@ -19,8 +19,8 @@ and a k-d tree over them (about 2.4 GiB) to confirm what its control points tell
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
-from lsys_core.geometry.kdtree import cKDTree
 from lsys_core.instancing.sampling import arc_fractions, sample_elements
 from lsys_core.svg.model import Element
 

@@ -25,8 +25,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
+from scipy.spatial import cKDTree
 
-from lsys_core.geometry.kdtree import cKDTree
 from lsys_core.instancing.deviation import pose_deviations
 from lsys_core.instancing.model import Instancing, terminal_shapes
 from lsys_core.instancing.sampling import arc_fractions, sample_elements

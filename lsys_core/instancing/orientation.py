@@ -16,8 +16,8 @@ from dataclasses import replace
 import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import breadth_first_order, connected_components, minimum_spanning_tree
+from scipy.spatial import cKDTree
 
-from lsys_core.geometry.kdtree import cKDTree
 from lsys_core.instancing.model import Instancing
 
 __all__ = ["ring_headings", "unwrap_symmetric", "unwrap_turns"]

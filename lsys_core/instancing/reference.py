@@ -9,8 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
-from lsys_core.geometry.kdtree import cKDTree
 from lsys_core.instancing.sampling import Samples
 
 __all__ = ["Batch", "Reference"]

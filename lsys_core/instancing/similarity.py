@@ -18,10 +18,10 @@ import math
 from collections import deque
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from lsys_core.cancel import CancelToken, Progress, check, report
 from lsys_core.errors import InferenceError
-from lsys_core.geometry.kdtree import cKDTree
 from lsys_core.grammar.model import Terminal
 from lsys_core.instancing.exact import EXACT_TOL, fit_exact, structure_key, variants
 from lsys_core.instancing.match import PERFECT, match_batch

@@ -8,8 +8,7 @@ angle.  Shapes that match themselves at any angle (circles) carry no rotation at
 from __future__ import annotations
 
 import numpy as np
-
-from lsys_core.geometry.kdtree import cKDTree
+from scipy.spatial import cKDTree
 
 __all__ = ["canonical", "symmetry_order"]
 
