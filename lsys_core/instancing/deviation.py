@@ -110,8 +110,7 @@ def _same_segments(
     ends = np.cumsum(counts)
     starts = ends - counts
     total = int(ends[-1])
-    own_parts = [_cubics(elements[i]) for i in same.tolist()]
-    first = np.array([c[0, 0] for c in own_parts], complex)
+    parts = [elements[i].cubics for i in same.tolist()]
     shape_cubics = np.concatenate([_cubics(s) for s in shapes])
     shape_start = (np.cumsum(shape_count) - shape_count)[which[same]]
     gap = np.empty(total)  # per segment of the elements of ``same``, one after another
@@ -121,12 +120,13 @@ def _same_segments(
         seg = np.arange(lo, hi)
         owner = np.searchsorted(ends, seg, side="right")  # index into ``same``
         j0, j1 = int(owner[0]), int(owner[-1])
-        own = np.concatenate(
-            [own_parts[j][max(lo - int(starts[j]), 0) : hi - int(starts[j])] for j in range(j0, j1 + 1)]
-        )
+        own = _block(parts, starts, j0, j1, lo, hi)
+        first = own[np.maximum(starts[j0 : j1 + 1] - lo, 0), 0]  # every element's first point
+        if starts[j0] < lo:
+            first[0] = complex(np.ravel(parts[j0])[0])
         posed = shape_cubics[shape_start[owner] + (seg - starts[owner])]
         gap[lo:hi] = np.abs(a_same[owner, None] * posed + b_same[owner, None] - own).max(axis=1)
-        size[lo:hi] = np.abs(own - first[owner, None]).max(axis=1)
+        size[lo:hi] = np.abs(own - first[owner - j0, None]).max(axis=1)
     bound = np.maximum.reduceat(gap, starts)  # per element of ``same``: the largest gap, the extent
     extent = np.maximum.reduceat(size, starts)
     ok = bound <= np.maximum(exact, _NEGLIGIBLE * extent)
@@ -134,6 +134,24 @@ def _same_segments(
     todo = np.ones(n, bool)
     todo[same[ok]] = False
     return out, np.flatnonzero(todo)
+
+
+def _block(parts: list, starts: np.ndarray, j0: int, j1: int, lo: int, hi: int) -> np.ndarray:
+    """Segments ``lo:hi`` of the cubics ``parts`` (of elements ``j0 … j1``) one after another, ``(hi - lo, 4)``.
+
+    Only the first and last parts are cut (by flat views): the block is one copy, not one
+    conversion and slice per element (those took 65 ms of every 50,000-leaf comparison).
+    """
+    s0 = 4 * int(starts[j0])
+    if j0 == j1:
+        flat = np.ravel(parts[j0])[4 * lo - s0 : 4 * hi - s0]
+    else:
+        s1 = 4 * int(starts[j1])
+        flat = np.concatenate(
+            [np.ravel(parts[j0])[4 * lo - s0 :], *parts[j0 + 1 : j1], np.ravel(parts[j1])[: 4 * hi - s1]],
+            axis=None,
+        )
+    return np.asarray(flat, complex).reshape(-1, 4)
 
 
 def _cubics(e: Element) -> np.ndarray:

@@ -23,7 +23,7 @@ from scipy.spatial import cKDTree
 from lsys_core.cancel import CancelToken, Progress, check, report
 from lsys_core.errors import InferenceError
 from lsys_core.grammar.model import Terminal
-from lsys_core.instancing.exact import EXACT_TOL, fit_exact, structure_key, variants
+from lsys_core.instancing.exact import EXACT_TOL, fit_exact, structure_ids, variants
 from lsys_core.instancing.match import PERFECT, match_batch
 from lsys_core.instancing.model import Instancing
 from lsys_core.instancing.reference import Batch, Reference
@@ -105,9 +105,7 @@ class _Matcher:
         self.coarse = coarse
         self.centroid = centroid
         self.radius = radius
-        keys = [structure_key(e) for e in elements]
-        ids = {k: i for i, k in enumerate(dict.fromkeys(keys))}
-        self.structure = np.array([ids[k] for k in keys])
+        self.structure = structure_ids(elements)
 
     def match(self, rep: _Rep, chunk: np.ndarray, threshold: float, mirrored: bool):
         """Match ``chunk`` against ``rep`` (flipped first if ``mirrored``).
