@@ -28,15 +28,20 @@ from scipy.spatial import cKDTree
 
 from lsys_core.hierarchy.clustering import group_indices, mean_shift
 from lsys_core.instancing.model import Instancing
+from lsys_core.parallel import jobs
 
 __all__ = ["estimate_pivots", "recenter"]
+
+#: Points from which neighbours are looked up on all workers (for fewer, starting threads costs more).
+_THREADED = 4096
 
 
 def _pivot_for(a: np.ndarray, b: np.ndarray, size: float, tol_angle: float, rng) -> complex:
     n = a.size
     k = min(8, n - 1)
     pts = np.column_stack([b.real, b.imag])
-    _, idx = cKDTree(pts).query(pts, k=k + 1)
+    # the same neighbours for any number of workers (threads only pay off for many points)
+    _, idx = cKDTree(pts).query(pts, k=k + 1, workers=jobs() if n >= _THREADED else 1)
     src = np.repeat(np.arange(n), k + 1)
     dst = np.asarray(idx).ravel()
     ok = (dst != src) & (dst < n)
