@@ -12,12 +12,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.sparse import csr_matrix
 from scipy.spatial import cKDTree
 
-from lsys_core.parallel import jobs
-from lsys_core.sorting import sorted_unique
+from lsys_core.parallel import jobs, pmap
 
 __all__ = ["PairSpace", "pair_space"]
+
+#: Pairs whose transforms one task on the workers computes.
+_CHUNK = 1 << 17
 
 
 @dataclass(frozen=True, eq=False)
@@ -53,6 +56,25 @@ class PairSpace:
         return int(self.src.size)
 
 
+def _symmetric_pairs(idx: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Both directions of every neighbour pair of ``idx`` (rows: a node's neighbours), once each.
+
+    Ordered by first node, then second: the pairs :func:`~lsys_core.sorting.sorted_unique` of
+    the codes ``src·n + dst`` of both directions gives.  The neighbours form a sparse matrix and
+    its transpose (a counting sort) is added to it (a merge of sorted rows): for the 1.2·10^6
+    pairs of a 50,052-leaf grid the sort of the codes took 200 ms, this 25 ms.
+    """
+    src = np.repeat(np.arange(n), idx.shape[1])
+    keep = (idx.ravel() != src) & (idx.ravel() < n)
+    indptr = np.zeros(n + 1, np.int64)
+    np.cumsum(np.count_nonzero(keep.reshape(n, -1), axis=1), out=indptr[1:])
+    near = csr_matrix((np.ones(int(indptr[-1]), np.int8), idx.ravel()[keep], indptr), shape=(n, n))
+    near.sort_indices()
+    union = (near + near.T.tocsr()).tocsr()
+    union.sort_indices()
+    return np.repeat(np.arange(n), np.diff(union.indptr)), union.indices.astype(np.int64)
+
+
 def pair_space(
     a: np.ndarray, b: np.ndarray, center: np.ndarray, radius: np.ndarray, k: int = 12
 ) -> PairSpace:
@@ -79,18 +101,22 @@ def pair_space(
     kk = min(k, n - 1)
     pts = np.column_stack([center.real, center.imag])
     _, idx = cKDTree(pts).query(pts, k=kk + 1, workers=jobs())
-    idx = np.atleast_2d(idx)
-    src = np.repeat(np.arange(n), kk + 1)
-    dst = idx.ravel()
-    keep = (dst != src) & (dst < n)
-    src, dst = src[keep], dst[keep]
-    # Symmetrise: keep both directions of every neighbour pair, once each.
-    both = np.concatenate([src * n + dst, dst * n + src])
-    both = sorted_unique(both)
-    src, dst = both // n, both % n
-    A = a[dst] / a[src]
-    B = (b[dst] - b[src]) / a[src]
-    alpha, d, s, beta = t4_from_rel(A, B)
-    dist = np.abs(center[dst] - center[src])
-    gap = np.maximum(dist - radius[src] - radius[dst], 0.0)
+    src, dst = _symmetric_pairs(np.atleast_2d(idx), n)
+    m = src.size
+    A, B = np.empty(m, complex), np.empty(m, complex)
+    alpha, d, s, beta, dist, gap = (np.empty(m) for _ in range(6))
+
+    def fill(span: tuple[int, int]) -> None:
+        """The pairs ``lo:hi``: every value is of its own pair, so any cut gives the same bits."""
+        part = slice(*span)
+        i, j = src[part], dst[part]
+        ai = a[i]
+        A[part] = a[j] / ai
+        B[part] = (b[j] - b[i]) / ai
+        alpha[part], d[part], s[part], beta[part] = t4_from_rel(A[part], B[part])
+        dist[part] = np.abs(center[j] - center[i])
+        gap[part] = np.maximum(dist[part] - radius[i] - radius[j], 0.0)
+
+    spans = [(lo, min(lo + _CHUNK, m)) for lo in range(0, m, _CHUNK)]
+    pmap(fill, spans)
     return PairSpace(src, dst, A, B, alpha, d, s, beta, dist, gap)
