@@ -221,8 +221,12 @@ def detect_similarity(
     )
     report(progress, _STAGE, 0.1)
     parsed = {st: _style_key(st) for st in {e.style for e in elements}}
-    key_ids = {k: i for i, k in enumerate(dict.fromkeys(parsed[e.style] for e in elements))}
-    key_of = np.array([key_ids[parsed[e.style]] for e in elements])
+    if len(set(parsed.values())) == 1:  # one key (as _style_key gives): no pass over the elements
+        key_ids = dict.fromkeys(parsed.values(), 0)
+        key_of = np.zeros(n, int)
+    else:
+        key_ids = {k: i for i, k in enumerate(dict.fromkeys(parsed[e.style] for e in elements))}
+        key_of = np.array([key_ids[parsed[e.style]] for e in elements])
     trees = {}
     for k in range(len(key_ids)):
         members = np.flatnonzero((key_of == k) & ~degenerate)
