@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from scipy.sparse import coo_matrix
+from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import breadth_first_order, connected_components, minimum_spanning_tree
 from scipy.spatial import cKDTree
 
@@ -42,10 +42,10 @@ def unwrap_turns(a: np.ndarray, b: np.ndarray, period: float) -> np.ndarray:
     pts = np.column_stack([b.real, b.imag])
     # the same neighbours for any number of workers (threads only pay off for many points)
     dist, idx = cKDTree(pts).query(pts, k=k + 1, workers=jobs() if n >= _THREADED else 1)
-    rows = np.repeat(np.arange(n), k)
-    cols = idx[:, 1:].ravel()
     w = dist[:, 1:].ravel() + 1e-12  # zero weights would be dropped from the sparse graph
-    graph = coo_matrix((w, (rows, cols)), shape=(n, n)).tocsr()
+    # rows of k neighbours, none twice: the matrix COO entries give, without their sort
+    graph = csr_matrix((w, idx[:, 1:].ravel(), np.arange(0, n * k + 1, k)), shape=(n, n))
+    graph.sort_indices()
     tree = minimum_spanning_tree(graph)
     tree = tree + tree.T
     _, comp = connected_components(tree, directed=False)
