@@ -79,6 +79,25 @@ def _style_key(style: str) -> str:
     return ""
 
 
+def _next_free(group: np.ndarray, cursor: int) -> int:
+    """The first element from ``cursor`` on in no group yet (``group < 0``), or ``group.size``.
+
+    Runs of grouped elements are skipped in slices of growing length (one by one in Python,
+    the 50,051 copies of a leaf took 10 ms).
+    """
+    n = group.size
+    if cursor >= n or group[cursor] < 0:
+        return cursor
+    step = 64
+    while cursor < n:
+        free = np.flatnonzero(group[cursor : cursor + step] < 0)
+        if free.size:
+            return cursor + int(free[0])
+        cursor += step
+        step = min(2 * step, 1 << 16)
+    return n
+
+
 class _Rep:
     """A representative: its element index, local origin (centroid), size and reference."""
 
@@ -250,8 +269,7 @@ def detect_similarity(
             if group[r] >= 0:
                 continue
         else:
-            while cursor < n and group[cursor] >= 0:
-                cursor += 1
+            cursor = _next_free(group, cursor)
             if cursor >= n:
                 break
             r, mirror = cursor, -1
