@@ -28,7 +28,7 @@ from scipy.spatial import cKDTree
 
 from lsys_core.hierarchy.clustering import group_indices, mean_shift
 from lsys_core.instancing.model import Instancing
-from lsys_core.parallel import jobs
+from lsys_core.parallel import jobs, pmap
 
 __all__ = ["estimate_pivots", "recenter"]
 
@@ -56,32 +56,42 @@ def _pivot_for(a: np.ndarray, b: np.ndarray, size: float, tol_angle: float, rng)
     lab, _ = mean_shift(
         np.column_stack([np.cos(np.angle(A)) / ang, np.sin(np.angle(A)) / ang, np.log(np.abs(A)) / 0.01])
     )
-    best, best_support = 0j, 0
     spacing = float(np.median(np.abs(b[dst] - b[src])))
-    for g in group_indices(lab):
-        if g.size < 4:
-            continue
+    groups = [g for g in group_indices(lab) if g.size >= 4]
+    draws = []  # drawn in the groups' order, as the votes were when they ran one after another
+    for g in groups:
+        m = min(4000, g.size * (g.size - 1) // 2)
+        draws.append((rng.integers(0, g.size, m), rng.integers(0, g.size, m)))
+
+    def vote(task: tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]) -> tuple[complex, int, complex] | None:
+        """The pivot one rotation cluster votes for, its support and displacement (or None)."""
+        g, (e1, e2) = task
         db = b[dst[g]] - b[src[g]]
         da = a[dst[g]] - a[src[g]]
-        m = min(4000, g.size * (g.size - 1) // 2)
-        e1 = rng.integers(0, g.size, m)
-        e2 = rng.integers(0, g.size, m)
         den = da[e1] - da[e2]
         good = np.abs(den) > 1e-9 * (np.abs(da[e1]) + 1e-300)
         if good.sum() < 3:
-            continue
+            return None
         o = (db[e2[good]] - db[e1[good]]) / den[good]
         o = o[np.isfinite(o) & (np.abs(o) < 20 * size)]
         if o.size < 3:
-            continue
+            return None
         _, modes = mean_shift(np.column_stack([o.real, o.imag]) / (0.02 * size))
         if modes.shape[0] == 0:
-            continue
+            return None
         cand = complex(*(modes[0] * 0.02 * size))
         D = db + da * cand
         lab2, dmodes = mean_shift(np.column_stack([D.real, D.imag]) / (0.02 * max(spacing, size)))
-        support = int(np.sum(lab2 == 0))
-        Dm = complex(*(dmodes[0] * 0.02 * max(spacing, size)))
+        return cand, int(np.sum(lab2 == 0)), complex(*(dmodes[0] * 0.02 * max(spacing, size)))
+
+    # the clusters are independent: large ones on the workers (for small ones threads cost more)
+    many = sum(g.size for g in groups) >= _THREADED
+    votes = pmap(vote, list(zip(groups, draws, strict=True)), workers=None if many else 1)
+    best, best_support = 0j, 0
+    for g, found in zip(groups, votes, strict=True):
+        if found is None:
+            continue
+        cand, support, Dm = found
         if support >= max(3, g.size // 3) and abs(Dm) > 0.5 * spacing and support > best_support:
             best, best_support = cand, support
     return best if abs(best) > 0.05 * size else 0j
