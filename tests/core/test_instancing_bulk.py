@@ -59,3 +59,47 @@ def test_stacked_cubics_are_the_stacked_elements() -> None:
     idx = np.array([0, 4, 5, 8])
     expected = np.stack([np.asarray(elements[i].cubics, complex).reshape(-1, 4) for i in idx])
     assert _stacked(elements, idx).tobytes() == expected.tobytes()
+
+
+def _rect(x: float, y: float, w: float, h: float) -> Element:
+    pts = np.array([x + 1j * y, x + w + 1j * y, x + w + 1j * (y + h), x + 1j * (y + h)])
+    ends = np.roll(pts, -1)
+    cubics = np.column_stack([pts, pts + (ends - pts) / 3, pts + 2 * (ends - pts) / 3, ends])
+    return Element(cubics, np.zeros(4, np.intp), (True,))
+
+
+def test_families_on_both_axes_are_the_families_of_fresh_stacks() -> None:
+    from lsys_core.instancing import stretch
+    from lsys_core.sorting import row_groups
+    from lsys_core.svg.model import Scene
+
+    tall = [_rect(10 * i, 0, 4, 5 + 3 * i) for i in range(5)]  # one width, heights differ: along y
+    wide = [_rect(0, 50 + 10 * i, 5 + 3 * i, 4) for i in range(5)]  # one height, widths differ: along x
+    other = [_rect(100, 100, 7, 7), _rect(120, 100, 7, 7)]
+    scene = Scene(tuple(tall + wide + other))
+    free = np.ones(len(scene.elements), bool)
+
+    def simple(tol: float):
+        out, taken = [], ~free
+        structure = structure_ids(scene.elements)
+        for axis in stretch._AXES:
+            avail = np.flatnonzero(~taken)
+            for run in sorted(stretch._runs(structure[avail]), key=lambda r: int(r[0])):
+                if run.size < 2:
+                    continue
+                idx = avail[run]
+                cubics = (
+                    np.stack([np.asarray(scene.elements[i].cubics, complex).reshape(-1, 4) for i in idx])
+                    * axis
+                )
+                key, length, _ = stretch._profiles(cubics, tol)
+                for sel in stretch._runs(row_groups(list(key.T))[1]):
+                    sel = sel[length[sel] > stretch._FLAT * tol]
+                    if sel.size >= 2 and np.ptp(length[sel]) > tol:
+                        out.append((axis, idx[sel]))
+                        taken[idx[sel]] = True
+        return out
+
+    got, expected = stretch._families(scene, free, 0.1), simple(0.1)
+    assert {axis for axis, _ in got} == {1, 1j}
+    assert [(axis, m.tolist()) for axis, m in got] == [(axis, m.tolist()) for axis, m in expected]
