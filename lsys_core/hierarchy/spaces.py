@@ -15,12 +15,9 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.spatial import cKDTree
 
-from lsys_core.parallel import jobs, pmap
+from lsys_core.parallel import jobs
 
 __all__ = ["PairSpace", "pair_space"]
-
-#: Pairs whose transforms one task on the workers computes.
-_CHUNK = 1 << 17
 
 
 @dataclass(frozen=True, eq=False)
@@ -102,21 +99,9 @@ def pair_space(
     pts = np.column_stack([center.real, center.imag])
     _, idx = cKDTree(pts).query(pts, k=kk + 1, workers=jobs())
     src, dst = _symmetric_pairs(np.atleast_2d(idx), n)
-    m = src.size
-    A, B = np.empty(m, complex), np.empty(m, complex)
-    alpha, d, s, beta, dist, gap = (np.empty(m) for _ in range(6))
-
-    def fill(span: tuple[int, int]) -> None:
-        """The pairs ``lo:hi``: every value is of its own pair, so any cut gives the same bits."""
-        part = slice(*span)
-        i, j = src[part], dst[part]
-        ai = a[i]
-        A[part] = a[j] / ai
-        B[part] = (b[j] - b[i]) / ai
-        alpha[part], d[part], s[part], beta[part] = t4_from_rel(A[part], B[part])
-        dist[part] = np.abs(center[j] - center[i])
-        gap[part] = np.maximum(dist[part] - radius[i] - radius[j], 0.0)
-
-    spans = [(lo, min(lo + _CHUNK, m)) for lo in range(0, m, _CHUNK)]
-    pmap(fill, spans)
+    A = a[dst] / a[src]
+    B = (b[dst] - b[src]) / a[src]
+    alpha, d, s, beta = t4_from_rel(A, B)
+    dist = np.abs(center[dst] - center[src])
+    gap = np.maximum(dist - radius[src] - radius[dst], 0.0)
     return PairSpace(src, dst, A, B, alpha, d, s, beta, dist, gap)
