@@ -40,6 +40,7 @@ from lsys_core.hierarchy.spaces import pair_space
 from lsys_core.hierarchy.symbols import SymbolTable
 from lsys_core.hierarchy.tabulated import find_tabulated, shortens, tabulated_rule
 from lsys_core.hierarchy.twins import find_twins, twins_rule, twins_shorten
+from lsys_core.parallel import submit
 
 __all__ = ["Hierarchy", "Tolerance", "Weights", "build_hierarchy"]
 
@@ -227,8 +228,10 @@ def build_hierarchy(
         ledger: Ledger | None = None
         t1 = time.perf_counter()
         if found is None:
-            ledger = Ledger(prec, nodes, table)
+            # the level's description length, beside its pairs (each reads only the nodes)
+            measured = submit(Ledger, prec, nodes, table)
             ps = pair_space(nodes.a, nodes.b, nodes.center, nodes.radius, k=neighbours)
+            ledger = measured.result()
             t1 = time.perf_counter()
             found = Level(find_candidates(ctx, nodes.sym, ps, nodes.radius, ledger))
             if cache is not None:
