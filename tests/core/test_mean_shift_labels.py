@@ -2,9 +2,13 @@
 
 :func:`lsys_core.hierarchy.clustering.mean_shift` labels large point sets by reasoning per
 half-bandwidth cell (a cell whose reach holds one mode needs no tree query).  With the
-threshold lowered to 0, every size takes that path; with it raised, every point is queried:
+thresholds lowered to 0, every size takes that path; with them raised, every point is queried:
 the labels and modes must be the same, including points farther than a bandwidth from every
 mode (singleton clusters) and cells between two modes.
+
+Seeds that meet bit for bit are moved by one query (``_distinct_rows``): with that on for every
+call and off for every call, the clusters, modes and ranks must be the same bit for bit,
+on scenes where many points sit on a few exact places (copies) and seeds merge.
 """
 
 from __future__ import annotations
@@ -30,7 +34,37 @@ def test_cell_labels_equal_tree_labels(seed: int, monkeypatch: pytest.MonkeyPatc
     monkeypatch.setattr(clustering, "_DIRECT", 10**12)
     by_tree = clustering.mean_shift(pts)
     monkeypatch.setattr(clustering, "_DIRECT", 0)
+    monkeypatch.setattr(clustering, "_PER_CELL", 0)
     monkeypatch.setattr(clustering, "_BLOCK", 97)  # several blocks, one of them partial
     by_cell = clustering.mean_shift(pts)
     np.testing.assert_array_equal(by_cell[0], by_tree[0])
     np.testing.assert_array_equal(by_cell[1], by_tree[1])
+
+
+def copies(seed: int) -> np.ndarray:
+    """Points on a few exact places (repeated transforms) with a jittered rest."""
+    rng = np.random.default_rng(seed)
+    dim = int(rng.integers(2, 7))
+    places = rng.normal(0.0, rng.uniform(1.0, 8.0), (int(rng.integers(1, 30)), dim))
+    exact = places[rng.integers(0, len(places), int(rng.integers(100, 3000)))]
+    near = places[rng.integers(0, len(places), int(rng.integers(0, 3000)))]
+    return np.vstack([exact, near + rng.normal(0.0, rng.uniform(0.01, 0.6), near.shape)])
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_seeds_at_one_place_queried_once(seed: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    pts = copies(seed)
+    monkeypatch.setattr(clustering, "_DISTINCT", 10**12)
+    each = clustering.ranked_mean_shift(pts)
+    monkeypatch.setattr(clustering, "_DISTINCT", 0)
+    once = clustering.ranked_mean_shift(pts)
+    for a, b in zip(once, each, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_distinct_rows_groups_equal_rows() -> None:
+    rows = np.array([[1.0, 2.0], [3.0, 4.0], [1.0, 2.0], [-0.0, 0.0], [0.0, 0.0], [3.0, 4.0]])
+    many = np.repeat(rows, 1000, axis=0)
+    first, inverse = clustering._distinct_rows(many)
+    np.testing.assert_array_equal(many[first[inverse]], many)
+    assert first.size == 4  # -0.0 and 0.0 differ bit for bit: kept apart, never wrongly merged
