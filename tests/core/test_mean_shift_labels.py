@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from lsys_core import parallel
 from lsys_core.hierarchy import clustering
 
 
@@ -68,3 +69,18 @@ def test_distinct_rows_groups_equal_rows() -> None:
     first, inverse = clustering._distinct_rows(many)
     np.testing.assert_array_equal(many[first[inverse]], many)
     assert first.size == 4  # -0.0 and 0.0 differ bit for bit: kept apart, never wrongly merged
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_ball_queries_in_parts_equal_one_query(seed: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    pts = copies(seed)
+    parallel.set_jobs(1)
+    try:
+        whole = clustering.ranked_mean_shift(pts)
+        monkeypatch.setattr(clustering, "_THREADED_FULL", 0)
+        parallel.set_jobs(3)
+        parts = clustering.ranked_mean_shift(pts)
+    finally:
+        parallel.set_jobs(None)
+    for a, b in zip(parts, whole, strict=True):
+        np.testing.assert_array_equal(a, b)
