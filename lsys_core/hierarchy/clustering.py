@@ -118,7 +118,17 @@ def _suppress(seeds: np.ndarray, order: np.ndarray) -> np.ndarray:
     kept without looking further; only the others go through the loop (with nearly isolated
     points, 10^5 seeds went one by one through ``query_ball_point`` lists; mean shift of 10^5
     isolated 4-D points took 1.83 s of CPU, now 0.65 s).
+
+    Seeds at one place (bit for bit) are one: the first of them in ``order`` is kept or
+    suppressed as the place is, the others are suppressed by it or with it.  So are seeds
+    outside ``order``: they suppress nothing.  Only the leading seed of every place is
+    examined: 42,653 of the 84,106 seeds of a wind chart's pair space (3.0·10^6 pairs of
+    seeds within half a bandwidth, most of them of equal seeds; 1.35 -> 0.11 s).
     """
+    first, _ = _distinct_rows(seeds[order])
+    if first.size < order.size:
+        lead = order[np.sort(first)]  # the first seed of every place, in order
+        return lead[_suppress(seeds[lead], np.arange(lead.size))]
     pairs = cKDTree(seeds).query_pairs(r=0.5, output_type="ndarray")
     if pairs.size == 0:
         return order

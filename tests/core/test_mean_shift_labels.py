@@ -84,3 +84,21 @@ def test_ball_queries_in_parts_equal_one_query(seed: int, monkeypatch: pytest.Mo
         parallel.set_jobs(None)
     for a, b in zip(parts, whole, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+def naive_suppress(seeds: np.ndarray, order: np.ndarray) -> np.ndarray:
+    kept: list[int] = []
+    for i in order.tolist():
+        if all(np.linalg.norm(seeds[i] - seeds[k]) > 0.5 for k in kept):
+            kept.append(i)
+    return np.array(kept, np.int64)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_suppress_keeps_the_strongest_seed_of_every_place(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    places = rng.uniform(0.0, 6.0, (40, 2))
+    seeds = places[rng.integers(0, 40, 5000)]  # many seeds at each place, bit for bit
+    seeds[::7] += rng.normal(0.0, 0.3, seeds[::7].shape)
+    order = rng.permutation(len(seeds))[: len(seeds) - 300]  # some seeds are too weak to count
+    np.testing.assert_array_equal(clustering._suppress(seeds, order), naive_suppress(seeds, order))
