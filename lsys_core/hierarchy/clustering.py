@@ -71,7 +71,9 @@ def _row_keys(cells: np.ndarray) -> np.ndarray:
     return h.view(np.int64)
 
 
-def _ball_pairs(query: np.ndarray, tree: cKDTree, r: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+def _ball_pairs(
+    query: np.ndarray, tree: cKDTree, r: float = 1.0, crowded: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Return ``(i, j)`` for every point ``j`` of ``tree`` within ``r`` of ``query[i]`` (vectorised).
 
     The :data:`_NEAR` nearest points of every query come from one ``query`` call (on
@@ -79,12 +81,16 @@ def _ball_pairs(query: np.ndarray, tree: cKDTree, r: float = 1.0) -> tuple[np.nd
     whose :data:`_NEAR` nearest are all within ``r`` may have more, and only those go through
     ``sparse_distance_matrix``.  Most seeds of a pair space are nearly isolated: for 10^5 of
     them the query takes 0.20 s of CPU where ``sparse_distance_matrix`` took 0.25 s, and a
-    large query runs on every core (so do the ball queries of many seeds, in parts).  Each query's points come in increasing order of ``j``.
+    large query runs on every core (so do the ball queries of many seeds, in parts).
+    Queries flagged ``crowded`` (they had that many neighbours at their last place) skip the
+    nearest-points query and go straight to the ball query: the same pairs, one query fewer.
+    Each query's points come in increasing order of ``j``.
     """
     k = min(_NEAR, tree.n)
-    workers = parallel.jobs() if len(query) >= _THREADED else 1  # threads cost ~1 ms per call
-    dist, idx = tree.query(query, k=k, distance_upper_bound=r * (1 + 1e-9), workers=workers)
-    dist, idx = dist.reshape(len(query), k), idx.reshape(len(query), k)
+    near = np.arange(len(query)) if crowded is None else np.flatnonzero(~crowded)
+    workers = parallel.jobs() if len(near) >= _THREADED else 1  # threads cost ~1 ms per call
+    dist, idx = tree.query(query[near], k=k, distance_upper_bound=r * (1 + 1e-9), workers=workers)
+    dist, idx = dist.reshape(len(near), k), idx.reshape(len(near), k)
     inside = dist <= r
     full = np.flatnonzero(inside[:, -1]) if k < tree.n else np.zeros(0, np.intp)
     inside[full] = False
@@ -94,14 +100,17 @@ def _ball_pairs(query: np.ndarray, tree: cKDTree, r: float = 1.0) -> tuple[np.nd
     idx.sort(axis=1)
     i, col = np.nonzero(idx < tree.n)
     j = idx[i, col]
+    i = near[i]
+    full = near[full] if crowded is None else np.union1d(near[full], np.flatnonzero(crowded))
     if full.size:
         parts = np.array_split(full, parallel.jobs()) if full.size >= _THREADED_FULL else [full]
         found = parallel.pmap(lambda part: _ball(query[part], tree, r, part), parts)
-        fi = np.concatenate([f[0] for f in found])
-        fj = np.concatenate([f[1] for f in found])
-        by = np.lexsort((fj, fi))
-        i = np.concatenate([i, fi[by]])
-        j = np.concatenate([j, fj[by]])
+        # sorted by (query, point) as one key: a tenth of the time of a lexsort of the two
+        key = np.concatenate([f[0].astype(np.int64) * tree.n + f[1] for f in found])
+        key.sort()
+        fi, fj = np.divmod(key, tree.n)
+        i = np.concatenate([i, fi])
+        j = np.concatenate([j, fj])
     return i.astype(np.intp), j.astype(np.intp)
 
 
@@ -341,9 +350,11 @@ def ranked_mean_shift(
     seeds = cent.copy()
     active = np.arange(len(seeds))
     still_owner, still_flat = [], []  # the neighbours of seeds that stopped exactly where they were
+    crowded = np.zeros(len(seeds), bool)  # seeds with ≥ _NEAR neighbours at their last place
     for _ in range(max_iter):
         first, alike = _distinct_rows(seeds[active])  # seeds at one place are queried once
-        owner, flat = _ball_pairs(seeds[active[first]], tree)
+        owner, flat = _ball_pairs(seeds[active[first]], tree, crowded=crowded[active[first]])
+        crowded[active] = (np.bincount(owner, minlength=first.size) >= _NEAR)[alike]
         ws = w[flat]
         dim = seeds.shape[1]
         num = np.column_stack(

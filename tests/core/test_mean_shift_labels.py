@@ -102,3 +102,25 @@ def test_suppress_keeps_the_strongest_seed_of_every_place(seed: int) -> None:
     seeds[::7] += rng.normal(0.0, 0.3, seeds[::7].shape)
     order = rng.permutation(len(seeds))[: len(seeds) - 300]  # some seeds are too weak to count
     np.testing.assert_array_equal(clustering._suppress(seeds, order), naive_suppress(seeds, order))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_crowded_queries_find_the_same_neighbours(seed: int) -> None:
+    """Seeds sent straight to the ball query (crowded) get the neighbours the nearest-points query gives."""
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(seed)
+    pts = copies(seed)
+    tree = cKDTree(pts)
+    query = pts[rng.integers(0, len(pts), 3000)] + rng.normal(0.0, 0.2, (3000, pts.shape[1]))
+    crowded = rng.random(3000) < 0.5
+
+    def per_owner(pairs: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        by = np.argsort(pairs[0], kind="stable")  # each owner's points keep their order
+        return pairs[0][by], pairs[1][by]
+
+    plain = per_owner(clustering._ball_pairs(query, tree))
+    routed = per_owner(clustering._ball_pairs(query, tree, crowded=crowded))
+    np.testing.assert_array_equal(routed[0], plain[0])
+    np.testing.assert_array_equal(routed[1], plain[1])
+    assert np.all(np.diff(routed[1])[np.diff(routed[0]) == 0] > 0)  # increasing points per owner
