@@ -20,6 +20,12 @@ from lsys_core import parallel
 from lsys_core.hierarchy import clustering
 
 
+def assert_same(got: tuple[np.ndarray, ...], expected: tuple[np.ndarray, ...]) -> None:
+    """Every array of two results equal, bit for bit."""
+    for a, b in zip(got, expected, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
 def scene(seed: int) -> np.ndarray:
     rng = np.random.default_rng(seed)
     dim = int(rng.integers(1, 7))
@@ -37,9 +43,7 @@ def test_cell_labels_equal_tree_labels(seed: int, monkeypatch: pytest.MonkeyPatc
     monkeypatch.setattr(clustering, "_DIRECT", 0)
     monkeypatch.setattr(clustering, "_PER_CELL", 0)
     monkeypatch.setattr(clustering, "_BLOCK", 97)  # several blocks, one of them partial
-    by_cell = clustering.mean_shift(pts)
-    np.testing.assert_array_equal(by_cell[0], by_tree[0])
-    np.testing.assert_array_equal(by_cell[1], by_tree[1])
+    assert_same(clustering.mean_shift(pts), by_tree)
 
 
 def copies(seed: int) -> np.ndarray:
@@ -58,9 +62,7 @@ def test_seeds_at_one_place_queried_once(seed: int, monkeypatch: pytest.MonkeyPa
     monkeypatch.setattr(clustering, "_DISTINCT", 10**12)
     each = clustering.ranked_mean_shift(pts)
     monkeypatch.setattr(clustering, "_DISTINCT", 0)
-    once = clustering.ranked_mean_shift(pts)
-    for a, b in zip(once, each, strict=True):
-        np.testing.assert_array_equal(a, b)
+    assert_same(clustering.ranked_mean_shift(pts), each)
 
 
 def test_distinct_rows_groups_equal_rows() -> None:
@@ -82,8 +84,7 @@ def test_ball_queries_in_parts_equal_one_query(seed: int, monkeypatch: pytest.Mo
         parts = clustering.ranked_mean_shift(pts)
     finally:
         parallel.set_jobs(None)
-    for a, b in zip(parts, whole, strict=True):
-        np.testing.assert_array_equal(a, b)
+    assert_same(parts, whole)
 
 
 def naive_suppress(seeds: np.ndarray, order: np.ndarray) -> np.ndarray:
