@@ -28,6 +28,7 @@ from typing import NoReturn
 
 from lsys_core.cli.args import build_parser
 from lsys_core.cli.commands import Progress, run_command
+from lsys_core.cpu import prefer_fast_sort
 from lsys_core.errors import LsysError
 from lsys_core.io import OutputClosed
 from lsys_core.parallel import keep_freed_memory, switching_often
@@ -83,7 +84,10 @@ def run() -> NoReturn:
     of a 0.9 s ``lsys infer`` of 1,200 elements (whole process, 7 pairs).  An exception raised
     by :func:`main` (``LSYS_DEBUG=1``; ``SystemExit`` of ``--help`` and usage errors) ends the
     process the usual way.  Programs that call :func:`main` themselves keep their process.
+    First, before numpy is imported, numpy is told to sort with its AVX2 code where its AVX-512
+    sort is slow (:func:`lsys_core.cpu.prefer_fast_sort`).
     """
+    prefer_fast_sort()
     status = main()
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(OSError, ValueError, AttributeError):

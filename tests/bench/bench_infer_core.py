@@ -8,6 +8,7 @@ seconds of the process and the load average.  ``BENCH_SIZES`` (default
 ``1200,20000,50000,100000``) and ``BENCH_JOBS`` (default ``1,2``) choose the cases.
 """
 
+# ruff: noqa: E402  (numpy is imported after prefer_fast_sort)
 from __future__ import annotations
 
 import math
@@ -16,6 +17,9 @@ import sys
 import time
 from pathlib import Path
 
+from lsys_core.cpu import prefer_fast_sort
+
+prefer_fast_sort()  # as the lsys command and the editor do, before numpy is imported
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
