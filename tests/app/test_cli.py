@@ -71,3 +71,23 @@ def test_screenshot_step_arguments_are_checked(tmp_path):
     proc = _run(str(example), "--screenshot", str(tmp_path / "x.png"), "--show", "nope")
     assert proc.returncode != 0 and "--show takes" in proc.stderr
     assert not (tmp_path / "x.png").exists()
+
+
+def test_editor_prefers_numpy_avx2_sort_on_zen4_before_numpy_loads():
+    """``lsys-editor`` sets the variable (inherited by its inference process) before numpy loads."""
+    zen4 = "vendor_id\t: AuthenticAMD\ncpu family\t: 25\n"
+    code = (
+        "import os, sys, lsys_core.cpu as c\n"
+        f"c._processor = lambda: {zen4!r}\n"
+        "c.numpy_version = lambda: (2, 4)\n"
+        "from lsys_editor.__main__ import main\n"
+        "assert 'numpy' not in sys.modules\n"
+        "try:\n"
+        "    main(['--version'])\n"
+        "except SystemExit:\n"
+        "    pass\n"
+        "print(os.environ.get(c.VARIABLE))\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "NPY_DISABLE_CPU_FEATURES"}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.splitlines()[-1] == "X86_V4 AVX512_ICL AVX512_SPR"
