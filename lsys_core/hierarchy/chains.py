@@ -106,11 +106,16 @@ def _link(
     order = np.lexsort((costs, cid))  # per cluster by cost; ties in pair order
     s_key = cid * n + src[items]
     d_key = cid * n + dst[items]
-    both = np.concatenate([s_key, d_key])
-    uniq = sorted_unique(both)
-    k = np.searchsorted(uniq, both)
-    ok = s_key != d_key
-    acc = np.flatnonzero(greedy_links([k[: items.size], k[items.size :]], order[ok[order]], uniq.size))
+    order = order[(s_key != d_key)[order]]  # a pair within one node links nothing
+    # The pairs' two ends as numbers 0, 1, ... (what greedy_links needs), the arrays that made
+    # them freed before it runs: they were a fifth of the level's peak memory.
+    k = np.concatenate([s_key, d_key])
+    uniq = sorted_unique(k)
+    k = np.searchsorted(uniq, k)
+    size = uniq.size
+    del uniq
+    acc = np.flatnonzero(greedy_links([k[: items.size], k[items.size :]], order, size))
+    del k, order
     a_src, a_dst = s_key[acc], d_key[acc]
     starts = sorted_unique(a_src[~isin(a_src, a_dst)])  # per cluster, in node order
     paths, loops = follow_links(a_src, a_dst, starts)

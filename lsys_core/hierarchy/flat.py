@@ -160,25 +160,28 @@ class Groups:
 
 def _walk(nxt: np.ndarray, heads: np.ndarray) -> Groups:
     """Groups from every head along ``nxt`` (-1: end), one step for all walkers at a time."""
-    rec_c, rec_p, rec_v = [], [], []
+    rec_c, rec_v = [], []
     cur = heads.astype(np.int64)
     chain = np.arange(heads.size, dtype=np.int64)
-    step = 0
     while cur.size:
         rec_c.append(chain)
         rec_v.append(cur)
-        rec_p.append(np.full(cur.size, step, np.int64))
         cur = nxt[cur]
         more = cur >= 0
         cur, chain = cur[more], chain[more]
-        step += 1
     if not rec_c:
         return Groups(np.zeros(0, np.int64), np.zeros(1, np.int64))
     c = np.concatenate(rec_c)
+    del rec_c
     lengths = np.bincount(c, minlength=heads.size)
     offsets = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
-    flat = np.empty(c.size, np.int64)
-    flat[offsets[c] + np.concatenate(rec_p)] = np.concatenate(rec_v)
+    # Every visit's place: its chain's offset plus its step (the record it is in), without a
+    # step array per record beside the others.
+    pos = offsets[c]
+    del c
+    pos += np.repeat(np.arange(len(rec_v), dtype=np.int64), [v.size for v in rec_v])
+    flat = np.empty(pos.size, np.int64)
+    flat[pos] = np.concatenate(rec_v)
     return Groups(flat, offsets)
 
 
@@ -292,9 +295,13 @@ def greedy_sets(
     end_of = np.repeat(ends, ends - starts)  # per entry: end of its item's run
     head = np.zeros(e_set.size, bool)
     head[starts] = True  # entries that are their item's first undecided set
+    del cut, starts, ends, lengths
     wait = np.bincount(e_set[~head], minlength=count)  # items where a set is not first yet
-    # Per set, its entries' positions in the sorted order (second sort: by set).
-    by_set = np.sort(e_set * np.int64(e_set.size) + np.arange(e_set.size)) % e_set.size
+    # Per set, its entries' positions in the sorted order (second sort: by set), sorted in place.
+    by_set = e_set * np.int64(e_set.size)
+    by_set += np.arange(e_set.size)
+    by_set.sort()
+    by_set %= e_set.size
     set_lo = np.concatenate([[0], np.cumsum(np.bincount(e_set, minlength=count))])
     state = np.zeros(count, np.int8)  # 0 undecided, 1 taken, 2 not taken
 
@@ -303,13 +310,22 @@ def greedy_sets(
         return by_set[_ranges(lo, n)]
 
     frontier = np.flatnonzero((wait == 0) & (rank < count))
+    del rank
     while frontier.size:
         state[frontier] = 1
         accept[frontier] = True
         ent = entries_of(frontier)
-        # Every later set at a taken item is not taken.
-        later = _ranges(ent + 1, end_of[ent] - ent - 1)
-        rej = sorted_unique(e_set[later])
+        # Every later set at a taken item is not taken (the first round holds most entries:
+        # its arrays are made in place and dropped as soon as used).
+        span = end_of[ent]
+        span -= ent
+        span -= 1
+        ent += 1
+        later = _ranges(ent, span)
+        del ent, span
+        rej = e_set[later]
+        del later
+        rej = sorted_unique(rej)
         rej = rej[state[rej] == 0]
         state[rej] = 2
         # Items where a rejected set was first: the first undecided set moves on.
@@ -335,7 +351,11 @@ def _ranges(lo: np.ndarray, n: np.ndarray) -> np.ndarray:
     total = int(n.sum())
     if total == 0:
         return np.zeros(0, np.int64)
-    return np.arange(total) - np.repeat(np.cumsum(n) - n, n) + np.repeat(lo, n)
+    # Per run, its first value less its first position, spread over the run, plus the positions:
+    # two arrays of the total at a time, where the three terms spread one by one held four.
+    out = np.repeat(np.asarray(lo, np.int64) - (np.cumsum(n) - n), n)
+    out += np.arange(total, dtype=np.int64)
+    return out
 
 
 def greedy_links(keys: list[np.ndarray], order: np.ndarray, size: int) -> np.ndarray:
@@ -359,8 +379,11 @@ def greedy_links(keys: list[np.ndarray], order: np.ndarray, size: int) -> np.nda
         Per item, whether it is taken.
     """
     n, k = keys[0].size, len(keys)
-    items = np.column_stack([key.astype(np.int64) + i * np.int64(size) for i, key in enumerate(keys)])
-    return greedy_sets(np.arange(n + 1, dtype=np.int64) * k, items.ravel(), order)
+    offsets = np.arange(n + 1, dtype=np.int64) * k
+    # (not named here: greedy_sets frees the entries once it has read them)
+    return greedy_sets(
+        offsets, np.column_stack([key + i * np.int64(size) for i, key in enumerate(keys)]).ravel(), order
+    )
 
 
 def greedy_disjoint(chains: Groups, order: np.ndarray, size: int) -> np.ndarray:
