@@ -63,6 +63,37 @@ def test_pmap_keeps_order_and_raises_the_workers_errors(restore_jobs) -> None:
     assert parallel.submit(fail, 2).result() == 2
 
 
+def test_nested_work_never_computes_on_more_threads_than_jobs(restore_jobs) -> None:
+    """pmap inside pmap inside submit: every result, and at most jobs() tasks running at once."""
+    import threading
+    import time
+
+    parallel.set_jobs(2)
+    lock = threading.Lock()
+    running, most = [0], [0]
+
+    def leaf(x: int) -> int:
+        with lock:
+            running[0] += 1
+            most[0] = max(most[0], running[0])
+        time.sleep(0.01)  # long enough for the others to start if nothing held them back
+        with lock:
+            running[0] -= 1
+        return x * x
+
+    def middle(x: int) -> list[int]:
+        return parallel.pmap(leaf, range(x, x + 4))
+
+    def outer() -> list[list[int]]:
+        return parallel.pmap(middle, range(0, 12, 4))
+
+    beside = parallel.submit(outer)
+    here = parallel.pmap(middle, range(100, 112, 4))
+    assert beside.result() == [[x * x for x in range(k, k + 4)] for k in range(0, 12, 4)]
+    assert here == [[x * x for x in range(k, k + 4)] for k in range(100, 112, 4)]
+    assert 1 <= most[0] <= 2
+
+
 def test_jobs_follow_the_environment_and_reject_nonsense(monkeypatch, restore_jobs) -> None:
     parallel.set_jobs(None)
     monkeypatch.setenv("LSYS_JOBS", "3")
