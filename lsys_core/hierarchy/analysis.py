@@ -67,11 +67,19 @@ def find_candidates(
     tol = ctx.tol
     size = np.maximum(ctx.sizes()[sym[ps.src]], 1e-9)
     key = space_key(sym, ps)
-    th = np.angle(ps.A)
     xy, ang, scale = _bandwidths(tol, size, ps, ledger)
     terminal_sizes = ctx.sizes()[: ctx.n_terminals]
     floor = tol.xy * float(np.median(terminal_sizes)) if terminal_sizes.size else 0.0
     xy = np.minimum(xy, spacing_cap(ps, key, sym[ps.src] >= ctx.n_terminals, sym.size, floor))
+    prox = proximity(ps, sym.size, radius)
+    # The linear sequences (clusters D) need nothing from the clusters C: found beside them
+    # (with one job, at once: before the embedding of the clusters C is made).
+    linear = (
+        submit(linear_candidates, ctx, sym, ps, prox, size, xy, key, ledger)
+        if len(ps) <= BESIDE_PAIRS
+        else None
+    )
+    th = np.angle(ps.A)
     emb = np.column_stack(
         [
             ps.B.real / xy,
@@ -82,13 +90,7 @@ def find_candidates(
             key * 1e7,
         ]
     )
-    prox = proximity(ps, sym.size, radius)
-    # The linear sequences (clusters D) need nothing from the clusters C: found beside them.
-    linear = (
-        submit(linear_candidates, ctx, sym, ps, prox, size, xy, key, ledger)
-        if len(ps) <= BESIDE_PAIRS
-        else None
-    )
+    del th
     labels, _ = mean_shift(emb)
     if ledger is not None:
         hopeless = cluster_bounds(ledger, labels, ps.src, ps.dst) <= 0.0
