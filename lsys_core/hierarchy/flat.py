@@ -380,9 +380,14 @@ def greedy_links(keys: list[np.ndarray], order: np.ndarray, size: int) -> np.nda
     """
     n, k = keys[0].size, len(keys)
     offsets = np.arange(n + 1, dtype=np.int64) * k
-    # (not named here: greedy_sets frees the entries once it has read them)
+    # The entries are not named here: greedy_sets frees them once it has read them (19 of the
+    # 241 MiB at the peak of the largest level of a 50,052-leaf grid).
     return greedy_sets(
-        offsets, np.column_stack([key + i * np.int64(size) for i, key in enumerate(keys)]).ravel(), order
+        offsets,
+        np.column_stack(
+            [key.astype(np.int64, copy=False) + i * np.int64(size) for i, key in enumerate(keys)]
+        ).ravel(),
+        order,
     )
 
 
