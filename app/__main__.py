@@ -123,9 +123,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the editor; return the process exit status."""
     import multiprocessing
 
-    from lsys_core.cpu import prefer_fast_sort
+    from lsys_core.cpu import prefer_fast_sort, prefer_small_pages
 
-    prefer_fast_sort()  # before numpy is imported; the inference process inherits it
+    prefer_fast_sort()  # before numpy is imported; the inference process inherits them
+    prefer_small_pages()
     multiprocessing.freeze_support()  # the inference worker process of a frozen build
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")

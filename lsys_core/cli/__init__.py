@@ -28,7 +28,7 @@ from typing import NoReturn
 
 from lsys_core.cli.args import build_parser
 from lsys_core.cli.commands import Progress, run_command
-from lsys_core.cpu import prefer_fast_sort
+from lsys_core.cpu import prefer_fast_sort, prefer_small_pages
 from lsys_core.errors import LsysError
 from lsys_core.io import OutputClosed
 from lsys_core.parallel import keep_freed_memory, switching_often
@@ -85,9 +85,11 @@ def run() -> NoReturn:
     by :func:`main` (``LSYS_DEBUG=1``; ``SystemExit`` of ``--help`` and usage errors) ends the
     process the usual way.  Programs that call :func:`main` themselves keep their process.
     First, before numpy is imported, numpy is told to sort with its AVX2 code where its AVX-512
-    sort is slow (:func:`lsys_core.cpu.prefer_fast_sort`).
+    sort is slow (:func:`lsys_core.cpu.prefer_fast_sort`) and, in a virtual machine, not to ask
+    for huge pages (:func:`lsys_core.cpu.prefer_small_pages`).
     """
     prefer_fast_sort()
+    prefer_small_pages()
     status = main()
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(OSError, ValueError, AttributeError):

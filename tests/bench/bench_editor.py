@@ -41,9 +41,10 @@ from pathlib import Path
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from lsys_core.cpu import prefer_fast_sort
+from lsys_core.cpu import prefer_fast_sort, prefer_small_pages
 
 prefer_fast_sort()  # as the editor does first thing, before numpy is imported
+prefer_small_pages()
 
 LEAF = '"M 0 0 Q 5 -8 14 -2 Q 9 2 0 0 Z" style "fill:#66bb6a;stroke:#1b5e20;stroke-width:0.6"'
 

@@ -17,9 +17,10 @@ import sys
 import time
 from pathlib import Path
 
-from lsys_core.cpu import prefer_fast_sort
+from lsys_core.cpu import prefer_fast_sort, prefer_small_pages
 
 prefer_fast_sort()  # as the lsys command and the editor do, before numpy is imported
+prefer_small_pages()
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))

@@ -9,7 +9,16 @@ import sys
 
 import pytest
 
-from lsys_core.cpu import FEATURES, VARIABLE, numpy_version, prefer_fast_sort, slow_compress_store
+from lsys_core.cpu import (
+    FEATURES,
+    HUGEPAGE,
+    VARIABLE,
+    in_virtual_machine,
+    numpy_version,
+    prefer_fast_sort,
+    prefer_small_pages,
+    slow_compress_store,
+)
 
 ZEN4_LINUX = (
     "processor\t: 0\nvendor_id\t: AuthenticAMD\ncpu family\t: 25\nmodel\t\t: 17\nflags\t\t: avx512f\n"
@@ -17,6 +26,7 @@ ZEN4_LINUX = (
 ZEN5_LINUX = ZEN4_LINUX.replace(": 25", ": 26")
 INTEL_LINUX = "processor\t: 0\nvendor_id\t: GenuineIntel\ncpu family\t: 6\nmodel\t\t: 143\n"
 ZEN4_WINDOWS = "AMD64 Family 25 Model 17 Stepping 1, AuthenticAMD"
+ZEN4_VM = ZEN4_LINUX.replace("flags\t\t: avx512f", "flags\t\t: fpu avx512f hypervisor vmmcall")
 
 
 @pytest.mark.parametrize(
@@ -105,3 +115,55 @@ def test_lsys_sets_it_before_numpy_is_imported() -> None:
     env = {k: v for k, v in os.environ.items() if k != VARIABLE}
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     assert out.stdout.splitlines()[-1] == FEATURES
+
+
+@pytest.mark.parametrize(
+    ("description", "vm"),
+    [
+        (ZEN4_VM, True),
+        (ZEN4_LINUX, False),
+        (INTEL_LINUX, False),  # no flags line
+        (ZEN4_LINUX.replace("avx512f", "avx512f hypervisorx"), False),  # whole flags only
+        (ZEN4_WINDOWS, False),
+    ],
+)
+def test_in_virtual_machine_reads_the_hypervisor_flag(description: str, vm: bool) -> None:
+    assert in_virtual_machine(description) is vm
+
+
+def test_small_pages_in_a_virtual_machine_only_and_never_over_the_user() -> None:
+    env: dict[str, str] = {}
+    assert prefer_small_pages(env, ZEN4_VM)
+    assert env == {HUGEPAGE: "0"}
+    for env, processor in (({HUGEPAGE: "1"}, ZEN4_VM), ({HUGEPAGE: ""}, ZEN4_VM), ({}, ZEN4_LINUX)):
+        before = dict(env)
+        assert not prefer_small_pages(env, processor)
+        assert env == before
+
+
+def test_numpy_reads_the_huge_page_variable() -> None:
+    import numpy as np
+
+    if not hasattr(np._core.multiarray, "_get_madvise_hugepage"):
+        pytest.skip("this numpy does not say whether it asks for huge pages")
+    code = "import numpy as np; print(np._core.multiarray._get_madvise_hugepage())"
+    env = dict(os.environ, **{HUGEPAGE: "0"})
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_lsys_asks_for_small_pages_in_a_virtual_machine_before_numpy_is_imported() -> None:
+    code = (
+        "import os, sys, lsys_core.cpu as c, lsys_core.cli as cli\n"
+        f"c._processor = lambda: {ZEN4_VM!r}\n"
+        "assert 'numpy' not in sys.modules\n"
+        "sys.argv = ['lsys', '--version']\n"
+        "try:\n"
+        "    cli.run()\n"
+        "except SystemExit:\n"
+        "    pass\n"
+        "print(os.environ.get(c.HUGEPAGE))\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k != HUGEPAGE}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.splitlines()[-1] == "0"
