@@ -73,12 +73,13 @@ def test_screenshot_step_arguments_are_checked(tmp_path):
     assert not (tmp_path / "x.png").exists()
 
 
-def test_editor_prefers_numpy_avx2_sort_on_zen4_before_numpy_loads():
-    """``lsys-editor`` sets the variable (inherited by its inference process) before numpy loads."""
-    zen4 = "vendor_id\t: AuthenticAMD\ncpu family\t: 25\n"
+def test_editor_sets_numpy_variables_before_numpy_loads():
+    """``lsys-editor`` sets numpy's sort and page variables (inherited by its inference process)
+    before numpy loads: AVX2 sort on Zen 4, small pages in a virtual machine."""
+    zen4_vm = "vendor_id\t: AuthenticAMD\ncpu family\t: 25\nflags\t\t: avx512f hypervisor\n"
     code = (
         "import os, sys, lsys_core.cpu as c\n"
-        f"c._processor = lambda: {zen4!r}\n"
+        f"c._processor = lambda: {zen4_vm!r}\n"
         "c.numpy_version = lambda: (2, 4)\n"
         "from lsys_editor.__main__ import main\n"
         "assert 'numpy' not in sys.modules\n"
@@ -86,8 +87,10 @@ def test_editor_prefers_numpy_avx2_sort_on_zen4_before_numpy_loads():
         "    main(['--version'])\n"
         "except SystemExit:\n"
         "    pass\n"
-        "print(os.environ.get(c.VARIABLE))\n"
+        "print(os.environ.get(c.VARIABLE), os.environ.get(c.HUGEPAGE))\n"
     )
-    env = {k: v for k, v in os.environ.items() if k != "NPY_DISABLE_CPU_FEATURES"}
+    env = {
+        k: v for k, v in os.environ.items() if k not in ("NPY_DISABLE_CPU_FEATURES", "NUMPY_MADVISE_HUGEPAGE")
+    }
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
-    assert out.stdout.splitlines()[-1] == "X86_V4 AVX512_ICL AVX512_SPR"
+    assert out.stdout.splitlines()[-1] == "X86_V4 AVX512_ICL AVX512_SPR 0"
