@@ -32,6 +32,7 @@ called beside :func:`prefer_fast_sort`.
 
 from __future__ import annotations
 
+import functools
 import importlib.util
 import os
 import platform
@@ -86,8 +87,9 @@ def numpy_version() -> tuple[int, int] | None:
     return (int(m.group(1)), int(m.group(2))) if m else None
 
 
+@functools.cache
 def _processor() -> str:
-    """This machine's processor description (empty where it cannot be read)."""
+    """This machine's processor description (empty where it cannot be read); read once."""
     if sys.platform.startswith("linux"):
         try:
             with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as f:
@@ -95,6 +97,16 @@ def _processor() -> str:
         except OSError:
             return ""
     return platform.processor() if sys.platform == "win32" else ""
+
+
+def _unset(environ: MutableMapping[str, str] | None, name: str) -> MutableMapping[str, str] | None:
+    """The environment (``os.environ`` by default) if numpy's variable ``name`` may still be set in it.
+
+    None when it is already set (even to nothing: the user's choice) or, for ``os.environ``,
+    when numpy is already imported (it read its variables then).
+    """
+    env = os.environ if environ is None else environ
+    return None if name in env or (environ is None and "numpy" in sys.modules) else env
 
 
 def prefer_fast_sort(
@@ -119,10 +131,8 @@ def prefer_fast_sort(
         Whether the variable was set.  Not when numpy is already imported (too late), when the
         variable is already set, on other processors, or with another numpy.
     """
-    env = os.environ if environ is None else environ
-    if VARIABLE in env or (environ is None and "numpy" in sys.modules):
-        return False
-    if not slow_compress_store(_processor() if processor is None else processor):
+    env = _unset(environ, VARIABLE)
+    if env is None or not slow_compress_store(_processor() if processor is None else processor):
         return False
     found = numpy_version() if version is None else version
     if found is None or found < FIRST_NUMPY:
@@ -153,10 +163,8 @@ def prefer_small_pages(environ: MutableMapping[str, str] | None = None, processo
         Whether the variable was set.  Not when numpy is already imported, when the variable
         is already set, or outside a virtual machine (where huge pages are cheap).
     """
-    env = os.environ if environ is None else environ
-    if HUGEPAGE in env or (environ is None and "numpy" in sys.modules):
-        return False
-    if not in_virtual_machine(_processor() if processor is None else processor):
+    env = _unset(environ, HUGEPAGE)
+    if env is None or not in_virtual_machine(_processor() if processor is None else processor):
         return False
     env[HUGEPAGE] = "0"
     return True
