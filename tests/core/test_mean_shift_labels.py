@@ -8,7 +8,8 @@ mode (singleton clusters) and cells between two modes.
 
 Seeds that meet bit for bit are moved by one query (``_distinct_rows``): with that on for every
 call and off for every call, the clusters, modes and ranks must be the same bit for bit,
-on scenes where many points sit on a few exact places (copies) and seeds merge.
+on scenes where many points sit on a few exact places (copies) and seeds merge.  So must they
+when the seeds climb in parts on several workers (``_climb_parts``) and all at once on one.
 """
 
 from __future__ import annotations
@@ -85,6 +86,24 @@ def test_ball_queries_in_parts_equal_one_query(seed: int, monkeypatch: pytest.Mo
     finally:
         parallel.set_jobs(None)
     assert_same(parts, whole)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_seeds_climbing_in_parts_reach_the_same_modes(seed: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    pts = copies(seed) if seed % 2 else scene(seed)
+    climbs: list[int] = []
+    parts = clustering._climb_parts
+    monkeypatch.setattr(clustering, "_climb_parts", lambda cent: climbs.append(len(p := parts(cent))) or p)
+    parallel.set_jobs(1)
+    try:
+        whole = clustering.ranked_mean_shift(pts)
+        monkeypatch.setattr(clustering, "_CLIMB_PART", 1)
+        parallel.set_jobs(3)
+        in_parts = clustering.ranked_mean_shift(pts)
+    finally:
+        parallel.set_jobs(None)
+    assert climbs[0] == 1 and climbs[1] == 3  # one climb on one worker, three parts on three
+    assert_same(in_parts, whole)
 
 
 def naive_suppress(seeds: np.ndarray, order: np.ndarray) -> np.ndarray:
