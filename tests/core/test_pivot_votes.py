@@ -1,4 +1,4 @@
-"""The rotation clusters' pivot votes, run on the workers, elect what they elected one after another (hierarchy.pivots)."""
+"""The rotation clusters' pivot votes elect what they elected when each cluster drew and voted in turn (hierarchy.pivots)."""
 
 from __future__ import annotations
 
