@@ -41,6 +41,11 @@ __all__ = ["find_candidates"]
 #: (1.21·10^6 pairs, 2 jobs) took 10.6 instead of 12.2 s for 1.23 instead of 1.04 GB resident;
 #: a 100,010-leaf grid (2.41·10^6 pairs) needed 2.27 GB and was slower (37.8 against 31.1 s).
 BESIDE_PAIRS = 1_500_000
+#: Pairs from which the linear sequences are sought beside the constant clusters at all.  Below,
+#: both are a few milliseconds of small numpy calls that hold the interpreter: on two workers
+#: they waited for each other, and the 76 levels of a published flag (86 elements) took 5 %
+#: longer with 2 jobs than with 1 (see :data:`lsys_core.hierarchy.rules.LEDGER_BESIDE`).
+BESIDE_MIN_PAIRS = 20_000
 
 
 def find_candidates(
@@ -76,7 +81,7 @@ def find_candidates(
     # (with one job, at once: before the embedding of the clusters C is made).
     linear = (
         submit(linear_candidates, ctx, sym, ps, prox, size, xy, key, ledger)
-        if len(ps) <= BESIDE_PAIRS
+        if BESIDE_MIN_PAIRS <= len(ps) <= BESIDE_PAIRS
         else None
     )
     th = np.angle(ps.A)

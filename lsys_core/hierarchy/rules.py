@@ -48,6 +48,12 @@ __all__ = ["Hierarchy", "Tolerance", "Weights", "build_hierarchy"]
 MAX_LEVELS = 100
 #: Default tolerance, as a share of the drawing's diagonal, when none is given.
 DEFAULT_TOLERANCE = 0.005
+#: Live nodes from which a level's description length (:class:`~lsys_core.hierarchy.gain.Ledger`)
+#: is measured on another worker beside its pairs.  For fewer, a thread costs more than it saves
+#: (small numpy calls that hold the interpreter): with this and
+#: :data:`~lsys_core.hierarchy.analysis.BESIDE_MIN_PAIRS`, the published real-art files of up to
+#: a few hundred elements infer in the time of 1 job with 2 jobs, where they took 3-10 % longer.
+LEDGER_BESIDE = 1_000
 
 
 @dataclass(frozen=True)
@@ -229,9 +235,13 @@ def build_hierarchy(
         t1 = time.perf_counter()
         if found is None:
             # the level's description length, beside its pairs (each reads only the nodes)
-            measured = submit(Ledger, prec, nodes, table)
-            ps = pair_space(nodes.a, nodes.b, nodes.center, nodes.radius, k=neighbours)
-            ledger = measured.result()
+            if len(nodes) >= LEDGER_BESIDE:
+                measured = submit(Ledger, prec, nodes, table)
+                ps = pair_space(nodes.a, nodes.b, nodes.center, nodes.radius, k=neighbours)
+                ledger = measured.result()
+            else:
+                ps = pair_space(nodes.a, nodes.b, nodes.center, nodes.radius, k=neighbours)
+                ledger = Ledger(prec, nodes, table)
             t1 = time.perf_counter()
             found = Level(find_candidates(ctx, nodes.sym, ps, nodes.radius, ledger))
             if cache is not None:

@@ -127,9 +127,35 @@ def test_linear_sequences_taking_turns_give_the_same_rules(restore_jobs, monkeyp
 
     grid = _rotating_grid(6, 9)
     parallel.set_jobs(2)
+    monkeypatch.setattr(analysis, "BESIDE_MIN_PAIRS", 0)  # as a scene of 10^4 pairs and more does
     beside = format_grammar(infer(grid).grammar)
     monkeypatch.setattr(analysis, "BESIDE_PAIRS", 0)  # as a scene of millions of pairs does
     assert format_grammar(infer(grid).grammar) == beside
+
+
+def test_small_levels_start_no_threads_beside_and_give_the_same_rules(restore_jobs, monkeypatch) -> None:
+    """Below LEDGER_BESIDE nodes and BESIDE_MIN_PAIRS pairs a level's parts run one after another."""
+    from lsys_core.hierarchy import analysis, rules
+
+    started: list[str] = []
+
+    def counting(module):
+        def submit(fn, *args):
+            started.append(fn.__name__)
+            return parallel.submit(fn, *args)
+
+        monkeypatch.setattr(module, "submit", submit)
+
+    counting(analysis)
+    counting(rules)
+    grid = _rotating_grid(6, 9)
+    parallel.set_jobs(2)
+    alone = format_grammar(infer(grid).grammar)
+    assert started == []
+    monkeypatch.setattr(analysis, "BESIDE_MIN_PAIRS", 0)
+    monkeypatch.setattr(rules, "LEDGER_BESIDE", 0)
+    assert format_grammar(infer(grid).grammar) == alone
+    assert "Ledger" in started and "linear_candidates" in started
 
 
 def test_step_clusters_solved_in_parts_and_batches_give_the_same_rules(restore_jobs, monkeypatch) -> None:
