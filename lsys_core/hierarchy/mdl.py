@@ -167,8 +167,8 @@ def stack_table(headings: float, kmax: int) -> np.ndarray:
     """``log2 C(max(headings, k), k)`` for the stacks ``k = 0 … kmax``: what :func:`pose_bits` sums.
 
     ``table[stacks].sum()`` is bit for bit ``pose_bits``' sum of the same terms (the same values
-    in the same order), without a ``gammaln`` per cell: a ledger sums the stacks of a whole
-    family at every candidate it prices (see :class:`~lsys_core.hierarchy.gain.Ledger`).
+    in the same order), without a ``gammaln`` per cell; a ledger weighs each term by the cells
+    of that height (see :class:`~lsys_core.hierarchy.gain.Ledger`).
     """
     k = np.arange(int(kmax) + 1, dtype=float)
     return log2_binom(np.maximum(headings, k), k)

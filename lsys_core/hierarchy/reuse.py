@@ -95,7 +95,8 @@ class LevelView:
         self.cands = [replace(c, start=st) for c, st in zip(cands, starts, strict=True)]
         self.terms = importance_terms(self.cands)
         self._tested: IdentityMemo[Candidate, Candidate | None] = IdentityMemo()
-        self._ceilings: IdentityMemo[Candidate, float] = IdentityMemo()
+        self._ceilings: np.ndarray | None = None
+        self._index = {id(c): i for i, c in enumerate(self.cands)}
         self._rivals: Rivals | None = None
 
     def order(self, weights: Weights) -> tuple[np.ndarray, list[int]]:
@@ -109,8 +110,17 @@ class LevelView:
         return self._rivals
 
     def ceiling(self, c: Candidate) -> float:
-        """:meth:`~lsys_core.hierarchy.gain.Ledger.ceiling` of ``c``, remembered."""
-        return self._ceilings.get(c, self.ledger.ceiling)
+        """:meth:`~lsys_core.hierarchy.gain.Ledger.ceiling` of ``c``, one of the candidates.
+
+        Those of all the candidates are worked out together when the first is asked
+        (:meth:`~lsys_core.hierarchy.gain.Ledger.ceilings`): the choice asks nearly all of them.
+        """
+        if self._ceilings is None:
+            self._ceilings = self.ledger.ceilings(self.cands)
+        i = self._index.get(id(c))
+        if i is None or self.cands[i] is not c:
+            return self.ledger.ceiling(c)
+        return float(self._ceilings[i])
 
     def tested(
         self, test: Callable[[Candidate], Candidate | None]

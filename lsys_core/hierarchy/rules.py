@@ -265,6 +265,7 @@ def build_hierarchy(
                 measure=measure,
                 n_terminals=nt,
                 limit=limit,
+                ceiling=view.ceiling,
             )
             chosen = choose(
                 view.cands,

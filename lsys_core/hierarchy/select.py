@@ -70,6 +70,7 @@ def worthwhile(
     measure: Measure | None = None,
     n_terminals: int = 0,
     limit: float = np.inf,
+    ceiling: Callable[[Candidate], float] | None = None,
 ) -> Candidate | None:
     """The candidate with its numbers rounded, if it shortens the description within the tolerance.
 
@@ -85,8 +86,10 @@ def worthwhile(
     user's precision may, :data:`~lsys_core.hierarchy.snap.SHARE` of the tolerance) only when
     it moves no node more than ``snap`` of the tolerance farther than ``c`` does: exact copies
     100 along and 1 across keep their 1, however much tolerance is left.
+    ``ceiling`` gives :meth:`~lsys_core.hierarchy.gain.Ledger.ceiling` (a level's view has
+    those of all its candidates: :class:`~lsys_core.hierarchy.reuse.LevelView`).
     """
-    if ledger.ceiling(c) <= 0.0:
+    if (ledger.ceiling if ceiling is None else ceiling)(c) <= 0.0:
         return None  # whatever its numbers, it cannot pay (most candidates: rounding them costs more)
     c = snapped(c, nodes, limit, snap)
     if not _invertible(c):
