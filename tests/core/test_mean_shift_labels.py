@@ -74,17 +74,23 @@ def test_distinct_rows_groups_equal_rows() -> None:
     assert first.size == 4  # -0.0 and 0.0 differ bit for bit: kept apart, never wrongly merged
 
 
-@pytest.mark.parametrize("seed", range(10))
-def test_ball_queries_in_parts_equal_one_query(seed: int, monkeypatch: pytest.MonkeyPatch) -> None:
-    pts = copies(seed)
+def one_worker_then_three(
+    pts: np.ndarray, monkeypatch: pytest.MonkeyPatch, setting: str, value: int
+) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
+    """``ranked_mean_shift`` of ``pts`` on one worker, then on three with ``clustering.<setting> = value``."""
     parallel.set_jobs(1)
     try:
         whole = clustering.ranked_mean_shift(pts)
-        monkeypatch.setattr(clustering, "_THREADED_FULL", 0)
+        monkeypatch.setattr(clustering, setting, value)
         parallel.set_jobs(3)
-        parts = clustering.ranked_mean_shift(pts)
+        return whole, clustering.ranked_mean_shift(pts)
     finally:
         parallel.set_jobs(None)
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_ball_queries_in_parts_equal_one_query(seed: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    whole, parts = one_worker_then_three(copies(seed), monkeypatch, "_THREADED_FULL", 0)
     assert_same(parts, whole)
 
 
@@ -94,14 +100,7 @@ def test_seeds_climbing_in_parts_reach_the_same_modes(seed: int, monkeypatch: py
     climbs: list[int] = []
     parts = clustering._climb_parts
     monkeypatch.setattr(clustering, "_climb_parts", lambda cent: climbs.append(len(p := parts(cent))) or p)
-    parallel.set_jobs(1)
-    try:
-        whole = clustering.ranked_mean_shift(pts)
-        monkeypatch.setattr(clustering, "_CLIMB_PART", 1)
-        parallel.set_jobs(3)
-        in_parts = clustering.ranked_mean_shift(pts)
-    finally:
-        parallel.set_jobs(None)
+    whole, in_parts = one_worker_then_three(pts, monkeypatch, "_CLIMB_PART", 1)
     assert climbs[0] == 1 and climbs[1] == 3  # one climb on one worker, three parts on three
     assert_same(in_parts, whole)
 
