@@ -121,23 +121,14 @@ class Ledger:
         height: a candidate changes the heights of its own cells only, so pricing it takes
         time in proportion to its nodes, not to the family's cells (with one term per cell,
         choosing among the 66,000 candidates of a 4,817-element chart's levels took 5.6 s).
-        The sum is the same as one per cell up to rounding; :meth:`ceilings` forms it in the
-        same operations, bit for bit.
+        The sum is the same as one per cell up to rounding; :meth:`_savings` forms it in the
+        same operations for many candidates at once.
         """
         bits = float(total) * float(self.scale[f])
         table = self.tables[f]
         if table is not None:
             bits += float((table * heights).sum())
         return bits
-
-    def _left_heights(self, f: int, keys: np.ndarray) -> np.ndarray:
-        """The cell heights of family ``f`` once nodes in cells ``keys`` (one entry a node) are taken out."""
-        keys, taken = np.unique(keys, return_counts=True)
-        stacks = self.stacked[keys]
-        heights = self.heights[f].copy()
-        np.subtract.at(heights, stacks, 1)
-        np.add.at(heights, stacks - taken, 1)
-        return heights
 
     def _family_bits(self, f, n, counts, occupied=None, pose=None):
         u = self.occupied[f] if occupied is None else occupied
@@ -224,7 +215,7 @@ class Ledger:
         if self._last is not None and self._last[0] is c.groups:
             return self._last[1]
         known = self._saved.get(id(c.groups))
-        saved = known[1] if known is not None and known[0] is c.groups else self._saved_bits(c)
+        saved = known[1] if known is not None and known[0] is c.groups else float(self._savings([c])[0])
         first = c.groups.firsts
         stacks = _run_lengths(np.sort(self.cell[first]))  # np.unique(..., return_counts=True)[1]
         new = placement_set_bits(self.prec, len(c.groups), occupied=stacks.size, token=self.token)
@@ -249,6 +240,33 @@ class Ledger:
         m = len(cands)
         if m == 0:
             return np.zeros(0)
+        saved = self._savings(cands)
+        self._saved.update((id(c.groups), (c.groups, v)) for c, v in zip(cands, saved.tolist(), strict=True))
+        n_keys = self.stacked.size
+        n_groups = np.fromiter((len(c.groups) for c in cands), np.int64, m)
+        if self.single:  # distinct first nodes, distinct cells
+            occupied = n_groups
+        else:
+            firsts = np.concatenate([c.groups.firsts for c in cands])
+            occupied = distinct_counts(np.repeat(np.arange(m), n_groups), self.cell[firsts], m, n_keys)
+        new = placement_set_bits(
+            self.prec, n_groups.astype(float), occupied=occupied.astype(float), token=self.token
+        )
+        least: dict[tuple[type, tuple[int, int]], float] = {}  # by kind and space
+        for c in cands:
+            if (type(c), c.space) not in least:
+                least[type(c), c.space] = self._least_rule_bits(c)
+        rules = np.array([least[type(c), c.space] for c in cands])
+        return saved - new - rules
+
+    def _savings(self, cands: Sequence[Candidate]) -> np.ndarray:
+        """Bits saved taking every candidate's nodes out of their families' sets (see :meth:`_moved`).
+
+        Per candidate and family, the family's set is priced again with its cell heights less
+        the candidate's nodes (:meth:`_key_pose`, the same operations on rows of heights), all
+        candidates at once; the savings of a candidate's families are added in increasing order.
+        """
+        m = len(cands)
         sizes = np.fromiter((c.nodes().size for c in cands), np.int64, m)
         nodes = np.concatenate([c.nodes() for c in cands])
         owner = np.repeat(np.arange(m), sizes)
@@ -297,40 +315,7 @@ class Ledger:
             counts=self.counts[fam] - gone,
             token=self.token,
         )
-        saved = np.bincount(cand, before - after, minlength=m)
-        self._saved.update((id(c.groups), (c.groups, v)) for c, v in zip(cands, saved.tolist(), strict=True))
-        n_groups = np.fromiter((len(c.groups) for c in cands), np.int64, m)
-        if self.single:  # distinct first nodes, distinct cells
-            occupied = n_groups
-        else:
-            firsts = np.concatenate([c.groups.firsts for c in cands])
-            occupied = distinct_counts(np.repeat(np.arange(m), n_groups), self.cell[firsts], m, n_keys)
-        new = placement_set_bits(
-            self.prec, n_groups.astype(float), occupied=occupied.astype(float), token=self.token
-        )
-        least: dict[tuple[type, tuple[int, int]], float] = {}  # by kind and space
-        for c in cands:
-            if (type(c), c.space) not in least:
-                least[type(c), c.space] = self._least_rule_bits(c)
-        rules = np.array([least[type(c), c.space] for c in cands])
-        return saved - new - rules
-
-    def _saved_bits(self, c: Candidate) -> float:
-        """Bits saved taking ``c``'s nodes out of their families' sets (see :meth:`_moved`)."""
-        nodes = c.nodes()
-        fam = self.family[nodes]
-        saved = 0.0
-        families = sorted_unique(fam).tolist()
-        for f in families:
-            mine_nodes = nodes if len(families) == 1 else nodes[fam == f]  # one family: all of them
-            k = int(mine_nodes.size)
-            n = int(self.count[f])
-            heights = self._left_heights(f, self.cell[mine_nodes])
-            u = int(heights[1:].sum())
-            counts = float(self.counts[f] - self.node_counts[mine_nodes].sum())
-            pose = self._key_pose(f, int(self.stacked_sum[f]) - k, heights)
-            saved += self._whole_bits(f) - self._family_bits(f, n - k, counts, u, pose)
-        return saved
+        return np.bincount(cand, before - after, minlength=m)
 
     def rule_bits(self, c: Candidate) -> float:
         """Bits of the rule candidate ``c`` would write."""

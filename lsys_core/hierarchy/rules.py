@@ -235,13 +235,9 @@ def build_hierarchy(
         t1 = time.perf_counter()
         if found is None:
             # the level's description length, beside its pairs (each reads only the nodes)
-            if len(nodes) >= LEDGER_BESIDE:
-                measured = submit(Ledger, prec, nodes, table)
-                ps = pair_space(nodes.a, nodes.b, nodes.center, nodes.radius, k=neighbours)
-                ledger = measured.result()
-            else:
-                ps = pair_space(nodes.a, nodes.b, nodes.center, nodes.radius, k=neighbours)
-                ledger = Ledger(prec, nodes, table)
+            measured = submit(Ledger, prec, nodes, table) if len(nodes) >= LEDGER_BESIDE else None
+            ps = pair_space(nodes.a, nodes.b, nodes.center, nodes.radius, k=neighbours)
+            ledger = Ledger(prec, nodes, table) if measured is None else measured.result()
             t1 = time.perf_counter()
             found = Level(find_candidates(ctx, nodes.sym, ps, nodes.radius, ledger))
             if cache is not None:
