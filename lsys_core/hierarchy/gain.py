@@ -291,14 +291,16 @@ class Ledger:
         stacks = self.stacked[key]
         u = self.occupied[fam] - np.bincount(hit_row[stacks == taken], minlength=cand.size)
         pose = (self.stacked_sum[fam] - k).astype(float) * self.scale[fam]
-        for f in sorted_unique(fam).tolist():
+        present = sorted_unique(fam).tolist()
+        hit_fam = fam[hit_row]
+        for f in present:
             table = self.tables[f]
             if table is None:
                 continue
             rows = np.flatnonzero(fam == f)
             local = np.full(cand.size, -1)
             local[rows] = np.arange(rows.size)
-            mine = fam[hit_row] == f
+            mine = hit_fam == f
             width = table.size
             at = local[hit_row[mine]] * width
             moved = np.bincount(at + stacks[mine] - taken[mine], minlength=rows.size * width) - np.bincount(
@@ -306,7 +308,9 @@ class Ledger:
             )
             heights = self.heights[f] + moved.reshape(rows.size, width)
             pose[rows] = pose[rows] + (table * heights).sum(axis=1)
-        before = np.array([self._whole_bits(f) for f in range(n_fam)])[fam]
+        whole = np.zeros(n_fam)
+        whole[present] = [self._whole_bits(f) for f in present]  # only the families taken from
+        before = whole[fam]
         after = placement_set_bits(
             self.prec,
             (self.count[fam] - k).astype(float),
